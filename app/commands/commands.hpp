@@ -1,0 +1,14 @@
+#pragma once
+// One file per subcommand under app/commands/; each registers itself on the top-level CLI11 app.
+// A command's callback stores its exit status with set_exit_code(); ConfigError thrown from a
+// command is caught in main.cpp and printed as one line, exit status 2.
+#include <CLI/CLI.hpp>
+
+namespace abuopt::app {
+
+void set_exit_code(int code);
+int exit_code();
+
+void register_simulate(CLI::App& app);
+
+}  // namespace abuopt::app

@@ -1,0 +1,203 @@
+#include "abuopt/common/yaml_reader.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace abuopt {
+
+namespace {
+std::string fmt(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+}  // namespace
+
+Rule Rule::any() {
+  return {[](double v) { return std::isfinite(v) ? std::string() : std::string("must be finite"); }};
+}
+Rule Rule::positive() {
+  return {[](double v) { return (std::isfinite(v) && v > 0) ? std::string() : std::string("must be > 0"); }};
+}
+Rule Rule::non_negative() {
+  return {[](double v) { return (std::isfinite(v) && v >= 0) ? std::string() : std::string("must be >= 0"); }};
+}
+Rule Rule::in_range(double lo, double hi) {
+  return {[lo, hi](double v) {
+    return (std::isfinite(v) && v >= lo && v <= hi)
+               ? std::string()
+               : "must be in [" + fmt(lo) + ", " + fmt(hi) + "]";
+  }};
+}
+Rule Rule::at_least(double lo) {
+  return {[lo](double v) { return (std::isfinite(v) && v >= lo) ? std::string() : "must be >= " + fmt(lo); }};
+}
+
+std::string yaml_value_text(const YAML::Node& n) {
+  if (!n) return "<missing>";
+  if (n.IsScalar()) return n.Scalar();
+  if (n.IsNull()) return "null";
+  YAML::Emitter e;
+  e << YAML::Flow << n;
+  return e.c_str();
+}
+
+YamlReader::YamlReader(YAML::Node node, std::string path) : node_(std::move(node)), path_(std::move(path)) {
+  if (node_ && !node_.IsNull() && !node_.IsMap()) {
+    throw ConfigError(path_.empty() ? "<top level>" : path_, yaml_value_text(node_), "must be a mapping of keys");
+  }
+}
+
+YamlReader YamlReader::load_file(const std::string& file) {
+  YAML::Node n;
+  try {
+    n = YAML::LoadFile(file);
+  } catch (const YAML::BadFile&) {
+    throw ConfigError("config file '" + file + "' cannot be opened (missing or unreadable)");
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError("config file '" + file + "' is not valid YAML: line " + std::to_string(e.mark.line + 1) +
+                      ", column " + std::to_string(e.mark.column + 1) + ": " + e.msg);
+  }
+  if (!n || n.IsNull()) throw ConfigError("config file '" + file + "' is empty");
+  return YamlReader(n, "");
+}
+
+YamlReader YamlReader::load_string(const std::string& text, const std::string& name) {
+  YAML::Node n;
+  try {
+    n = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError("config '" + name + "' is not valid YAML: line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+  return YamlReader(n, "");
+}
+
+std::string YamlReader::key_path(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+
+bool YamlReader::has(const std::string& key) const { return present() && node_[key] && !node_[key].IsNull(); }
+
+YAML::Node YamlReader::at(const std::string& key) {
+  read_.insert(key);
+  if (!present()) return YAML::Node();
+  YAML::Node n = node_[key];
+  if (!n || n.IsNull()) return YAML::Node();
+  return n;
+}
+
+double YamlReader::scalar_as_double(const YAML::Node& n, const std::string& path, const Rule& rule) {
+  if (!n.IsScalar()) throw ConfigError(path, yaml_value_text(n), "must be a number");
+  double v = 0;
+  const std::string& s = n.Scalar();
+  try {
+    size_t used = 0;
+    v = std::stod(s, &used);
+    while (used < s.size() && std::isspace(static_cast<unsigned char>(s[used]))) ++used;
+    if (used != s.size()) throw std::invalid_argument("trailing");
+  } catch (const std::exception&) {
+    throw ConfigError(path, s, "must be a number");
+  }
+  const std::string broken = rule.check ? rule.check(v) : std::string();
+  if (!broken.empty()) throw ConfigError(path, s, broken);
+  return v;
+}
+
+double YamlReader::get_double(const std::string& key, const Rule& rule) {
+  YAML::Node n = at(key);
+  if (!n) throw ConfigError(key_path(key), "<missing>", "is required");
+  return scalar_as_double(n, key_path(key), rule);
+}
+
+double YamlReader::get_double_or(const std::string& key, double fallback, const Rule& rule) {
+  YAML::Node n = at(key);
+  if (!n) return fallback;
+  return scalar_as_double(n, key_path(key), rule);
+}
+
+long YamlReader::get_int(const std::string& key, const Rule& rule) {
+  YAML::Node n = at(key);
+  if (!n) throw ConfigError(key_path(key), "<missing>", "is required");
+  double v = scalar_as_double(n, key_path(key), rule);
+  if (v != std::floor(v) || std::fabs(v) > 9e15) throw ConfigError(key_path(key), n.Scalar(), "must be a whole number");
+  return static_cast<long>(v);
+}
+
+long YamlReader::get_int_or(const std::string& key, long fallback, const Rule& rule) {
+  if (!has(key)) {
+    read_.insert(key);
+    return fallback;
+  }
+  return get_int(key, rule);
+}
+
+bool YamlReader::get_bool_or(const std::string& key, bool fallback) {
+  YAML::Node n = at(key);
+  if (!n) return fallback;
+  const std::string s = n.IsScalar() ? n.Scalar() : std::string();
+  if (s == "true" || s == "yes" || s == "on") return true;
+  if (s == "false" || s == "no" || s == "off") return false;
+  throw ConfigError(key_path(key), yaml_value_text(n), "must be true or false");
+}
+
+std::string YamlReader::get_string(const std::string& key) {
+  YAML::Node n = at(key);
+  if (!n) throw ConfigError(key_path(key), "<missing>", "is required");
+  if (!n.IsScalar()) throw ConfigError(key_path(key), yaml_value_text(n), "must be a string");
+  return n.Scalar();
+}
+
+std::string YamlReader::get_string_or(const std::string& key, const std::string& fallback) {
+  if (!has(key)) {
+    read_.insert(key);
+    return fallback;
+  }
+  return get_string(key);
+}
+
+std::string YamlReader::get_choice_or(const std::string& key, const std::string& fallback,
+                                      const std::vector<std::string>& choices) {
+  std::string v = get_string_or(key, fallback);
+  for (const auto& c : choices)
+    if (c == v) return v;
+  std::string list;
+  for (size_t i = 0; i < choices.size(); ++i) list += (i ? ", " : "") + choices[i];
+  throw ConfigError(key_path(key), v, "must be one of: " + list);
+}
+
+std::vector<double> YamlReader::get_double_list(const std::string& key, const Rule& rule) {
+  YAML::Node n = at(key);
+  if (!n) throw ConfigError(key_path(key), "<missing>", "is required");
+  std::vector<double> out;
+  if (n.IsScalar()) {
+    out.push_back(scalar_as_double(n, key_path(key), rule));
+    return out;
+  }
+  if (!n.IsSequence()) throw ConfigError(key_path(key), yaml_value_text(n), "must be a number or a list of numbers");
+  for (size_t i = 0; i < n.size(); ++i)
+    out.push_back(scalar_as_double(n[i], key_path(key) + "[" + std::to_string(i) + "]", rule));
+  return out;
+}
+
+YamlReader YamlReader::child(const std::string& key) { return YamlReader(at(key), key_path(key)); }
+
+bool YamlReader::is_sequence(const std::string& key) const { return has(key) && node_[key].IsSequence(); }
+
+std::vector<YamlReader> YamlReader::children(const std::string& key) {
+  YAML::Node n = at(key);
+  std::vector<YamlReader> out;
+  if (!n) return out;
+  if (!n.IsSequence()) throw ConfigError(key_path(key), yaml_value_text(n), "must be a list");
+  for (size_t i = 0; i < n.size(); ++i) out.emplace_back(n[i], key_path(key) + "[" + std::to_string(i) + "]");
+  return out;
+}
+
+void YamlReader::finish() const {
+  if (!present()) return;
+  for (auto it = node_.begin(); it != node_.end(); ++it) {
+    const std::string k = it->first.as<std::string>();
+    if (!read_.count(k)) {
+      throw ConfigError(key_path(k), yaml_value_text(it->second), "unknown key (misspelt, or not valid here)");
+    }
+  }
+}
+
+}  // namespace abuopt

@@ -1,0 +1,86 @@
+#pragma once
+// The event-driven ABU simulator: one startup from rest, from given initial ball angles.
+//
+// The model (abu_model.hpp) is const and shared; each run owns its integrator state, so one
+// Simulator may run from many threads at once. Coulomb stick/slip is handled exactly: root
+// functions locate slip->stick (beta_i' = 0) and stick->slip (needed friction reaches mu fn_i);
+// at every event the modes of all balls are chosen together and the integrator restarts. The
+// report's own method (Leine's switch model: a thin band |beta'| < eta treated as stick) is an
+// option on the same model. Numerical trouble is an outcome status, never an exception.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "abuopt/core/motor.hpp"
+#include "abuopt/core/outcome.hpp"
+#include "abuopt/core/parameters.hpp"
+#include "abuopt/core/profile.hpp"
+
+namespace abuopt {
+
+enum class FrictionMethod { EventDriven, SwitchModel };
+enum class IntegratorBackend { ArkodeErk, Cvode };
+std::string to_string(FrictionMethod m);
+std::string to_string(IntegratorBackend b);
+
+struct SimulationOptions {
+  FrictionMethod method = FrictionMethod::EventDriven;
+  IntegratorBackend backend = IntegratorBackend::ArkodeErk;
+  std::string erk_table = "ARKODE_FEHLBERG_13_7_8";  // ARKODE built-in explicit table
+  double rtol = 1e-6;
+  double atol = 1e-9;              // on the non-dimensional state
+  double end_time_s = 0;           // <= 0: twice the profile duration (report's rule)
+  double switch_band = 1e-4;       // switch model: |beta'| / omega_n below this counts as stick
+  long max_steps = 2'000'000;
+  long max_events = 100'000;       // total stick/slip transitions
+  // Chatter guard: more than chatter_events transitions within chatter_window_s ends the run
+  // with status ChatterLimit.
+  long chatter_events = 200;
+  double chatter_window_s = 1e-3;
+  // After the profile ends with all balls stuck the system is linear and time-invariant; when a
+  // bound proves no ball can slip again the run jumps to the end time in closed form.
+  bool closed_form_tail = true;
+  double trajectory_interval_s = 0;  // > 0: record a trajectory point every this many seconds
+};
+
+// Per-run deviations from the nominal parameters (uncertain parameters of a Monte Carlo).
+struct RunOverrides {
+  std::optional<double> friction_mu;
+  std::optional<double> imbalance_mass_kg;
+  double imbalance_angle_rad = 0;  // rotates the imbalance; reported angles stay imbalance-relative
+};
+
+struct TrajectoryPoint {
+  double t_s, frequency_hz, x_m, y_m;
+  std::vector<double> beta;   // rad
+  std::vector<int> mode;      // 0 stick, +1 slip forward, -1 slip backward
+};
+
+struct SimulationSetup {
+  AbuParameters abu;
+  StartupProfile profile = StartupProfile::report_final();
+  MotorModel motor;
+  SimulationOptions options;
+};
+
+class Simulator {
+ public:
+  explicit Simulator(SimulationSetup setup);  // validates; throws ConfigError
+  ~Simulator();
+  Simulator(const Simulator&) = delete;
+  Simulator& operator=(const Simulator&) = delete;
+  Simulator(Simulator&&) noexcept;
+
+  // beta0.size() must equal the number of balls (ConfigError otherwise).
+  RunOutcome run(const std::vector<double>& beta0, const RunOverrides& overrides = {},
+                 std::vector<TrajectoryPoint>* trajectory = nullptr) const;
+
+  const SimulationSetup& setup() const { return setup_; }
+  double end_time_s() const;
+  std::size_t ball_count() const { return setup_.abu.balls.size(); }
+
+ private:
+  SimulationSetup setup_;
+};
+
+}  // namespace abuopt

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Installs abuopt's build and run dependencies from Debian's packages, only those missing.
+# Idempotent and non-interactive; needs root (or sudo) only when something is missing.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config git
+  libeigen3-dev          # linear algebra (model solves, response surfaces)
+  libsundials-dev        # ARKODE/CVODE with root finding: the event-driven simulator
+  libyaml-cpp-dev        # study configs
+  libnlopt-cxx-dev       # NLopt optimisers
+  coinor-libipopt-dev    # Ipopt
+  libsqlite3-dev         # evaluation archive
+  libcli11-dev           # command line parsing
+  nlohmann-json3-dev     # JSON output (--json, summaries)
+  libgtest-dev           # tests
+  libbenchmark-dev       # bench/
+  gnuplot-nox            # plots (optional at run time: studies skip plots without it)
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}" >&2
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
