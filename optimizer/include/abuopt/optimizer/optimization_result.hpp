@@ -1,0 +1,103 @@
+#pragma once
+// The one result type of every optimiser (the idea of Ceres' Solver::Summary): why it stopped,
+// the best feasible point, counts, time, the history of every evaluation, and brief/full reports.
+//
+// The best point found is ALWAYS returned, whatever ended the run (budget, time, callback,
+// Ctrl-C, an exception inside an evaluation). A run reports success() only if it converged AND
+// its best point is feasible: an optimiser that claims convergence at an infeasible point is
+// reported with reason `infeasible`.
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "abuopt/optimizer/problem.hpp"
+
+namespace abuopt::opt {
+
+enum class TerminationReason {
+  converged,            // the algorithm's own convergence test (no finer reason given)
+  converged_ftol,       // change of f below ftol_rel / ftol_abs
+  converged_xtol,       // change of x below xtol_rel (or Ipopt: search direction too small)
+  target_reached,       // a feasible point with f <= target
+  max_evaluations,      // evaluation budget used up
+  max_iterations,       // iteration limit (Ipopt)
+  max_time,             // wall-clock (or Ipopt CPU) limit
+  stopped_by_callback,  // the evaluation callback returned false
+  interrupted,          // SIGINT (Ctrl-C) or request_stop()
+  evaluation_error,     // an evaluation threw an exception
+  infeasible,           // the algorithm stopped without a feasible point
+  roundoff_limited,     // NLopt: roundoff errors limited progress
+  failure,              // the algorithm failed (message says why)
+};
+
+std::string to_string(TerminationReason reason);
+// Inverse of to_string; throws abuopt::ConfigError listing the valid names.
+TerminationReason termination_reason_from_string(const std::string& text);
+// converged, converged_ftol, converged_xtol, target_reached.
+bool is_convergence(TerminationReason reason);
+
+// One evaluation as the optimiser saw it.
+struct EvaluationRecord {
+  long index = 0;                  // 0-based order of evaluation in the run
+  std::vector<double> x;           // the point evaluated (inside the bounds)
+  double objective = 0.0;
+  std::vector<double> inequality;  // g(x)
+  std::vector<double> equality;    // h(x)
+  std::map<std::string, double> metrics;
+  bool ok = true;
+  bool feasible = false;           // ok and max_violation <= constraint_tolerance
+  double max_violation = 0.0;
+  bool from_archive = false;
+  bool for_gradient = false;       // a finite-difference neighbour, not a point the optimiser chose
+  double wall_time_s = 0.0;        // time of this evaluation
+  double elapsed_s = 0.0;          // time since the run started, at the end of this evaluation
+  std::string message;
+};
+
+struct OptimizationResult {
+  std::string problem_name;
+  std::string algorithm;           // as run, e.g. "AUGLAG(BOBYQA)"
+  TerminationReason reason = TerminationReason::failure;
+  std::string message;             // human-readable detail of the reason
+
+  // Best point: the feasible point with the lowest objective; if no point was feasible, the
+  // point with the smallest constraint violation (feasible == false). Empty x: no evaluation.
+  std::vector<double> x;
+  double objective = 0.0;
+  std::vector<double> inequality;
+  std::vector<double> equality;
+  std::map<std::string, double> metrics;
+  bool feasible = false;
+  double max_violation = 0.0;
+  double constraint_tolerance = 0.0;
+
+  std::vector<double> x0;          // starting point
+  long evaluations = 0;            // evaluations requested (including archive hits)
+  long archive_hits = 0;           // of which answered from an evaluation archive
+  long failed_evaluations = 0;     // ok == false
+  long gradient_evaluations = 0;   // of which finite-difference neighbours
+  long repeated_requests = 0;      // in-run repeats answered from memory (not counted above)
+  long clipped_requests = 0;       // requests outside the bounds that were clipped into them
+  long iterations = 0;             // Ipopt iterations; 0 for NLopt
+  double wall_time_s = 0.0;
+
+  std::vector<std::string> variable_names;
+  std::vector<std::string> inequality_names;
+  std::vector<std::string> equality_names;
+  std::vector<EvaluationRecord> history;  // every evaluation, in order (if keep_history)
+
+  // Converged and the best point is feasible.
+  bool success() const;
+  // A feasible point is available (whatever the reason).
+  bool has_feasible_point() const { return feasible && !x.empty(); }
+
+  // One line: "SLSQP on hs071: converged_ftol, f = 17.014017 (feasible), 131 evaluations
+  // (0 from archive), 0.004 s".
+  std::string brief_report() const;
+  // Several lines: reason and message, counts, the best point variable by variable, the
+  // constraints with their values, the metrics.
+  std::string full_report() const;
+};
+
+}  // namespace abuopt::opt

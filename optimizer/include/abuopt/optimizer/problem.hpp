@@ -1,0 +1,145 @@
+#pragma once
+// The problem contract every optimiser in abuopt::opt works on (the idea of pagmo's `problem`:
+// "fitness + bounds + counts of constraints", with benchmark problems carrying best_known()).
+//
+//   minimise   f(x)
+//   subject to g_i(x) <= 0      (inequality constraints, named)
+//              h_j(x)  = 0      (equality constraints, named)
+//              lower_k <= x_k <= upper_k   (every design variable is bounded and named)
+//
+// An evaluation may fail (a simulation that did not finish, a model outside its range): it then
+// returns ok = false and is treated by every optimiser as a point with objective +inf that is not
+// feasible. It never ends a run. An exception thrown from evaluate() is different: it is taken as
+// a defect and ends the run with reason `evaluation_error` (the best point so far is still
+// returned).
+//
+// The optimiser layer knows nothing of ABUs: metrics are plain named numbers.
+#include <cstddef>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace abuopt::opt {
+
+// One bounded design variable.
+struct Variable {
+  std::string name;
+  double lower = 0.0;
+  double upper = 1.0;
+  // Typical magnitude of the variable (> 0). Optimisers work on x / scale, and finite-difference
+  // steps are h * max(|x|, scale), so variables of very different size are treated alike.
+  double scale = 1.0;
+};
+
+// What one evaluation of the problem returns.
+struct Evaluation {
+  double objective = 0.0;                 // minimised
+  std::vector<double> inequality;         // g(x), feasible when <= 0; one per inequality name
+  std::vector<double> equality;           // h(x), feasible when == 0; one per equality name
+  std::map<std::string, double> metrics;  // any extra named outputs (for reports and archives)
+  bool ok = true;                         // false: the evaluation failed (see `message`)
+  std::string message;                    // why it failed, or a note
+  bool from_archive = false;              // answered from an evaluation archive, not computed
+
+  // A failed evaluation: objective +inf, no constraint values, the reason in `message`.
+  static Evaluation failed(std::string why);
+};
+
+// Best known solution of a benchmark problem.
+struct BestKnown {
+  std::vector<double> x;
+  double objective = 0.0;
+};
+
+class Problem {
+ public:
+  virtual ~Problem() = default;
+
+  virtual std::string name() const = 0;
+  virtual std::vector<Variable> variables() const = 0;
+  virtual std::vector<std::string> inequality_names() const { return {}; }
+  virtual std::vector<std::string> equality_names() const { return {}; }
+
+  // Evaluates the objective, the constraints and the metrics at x (x is inside the bounds and has
+  // one entry per variable: every optimiser checks this before calling).
+  virtual Evaluation evaluate(const std::vector<double>& x) = 0;
+
+  // Starting point when the caller gives none; default: the middle of the bounds.
+  virtual std::vector<double> initial_point() const;
+
+  // Best known solution, for benchmarks; empty for real problems.
+  virtual std::optional<BestKnown> best_known() const { return std::nullopt; }
+
+  std::size_t dimension() const { return variables().size(); }
+};
+
+// A problem made of functions (handy for tests and small studies).
+class FunctionProblem : public Problem {
+ public:
+  using Function = std::function<Evaluation(const std::vector<double>&)>;
+  FunctionProblem(std::string name, std::vector<Variable> variables, Function function,
+                  std::vector<std::string> inequality_names = {},
+                  std::vector<std::string> equality_names = {});
+  std::string name() const override { return name_; }
+  std::vector<Variable> variables() const override { return variables_; }
+  std::vector<std::string> inequality_names() const override { return inequality_names_; }
+  std::vector<std::string> equality_names() const override { return equality_names_; }
+  Evaluation evaluate(const std::vector<double>& x) override { return function_(x); }
+  std::vector<double> initial_point() const override;
+  std::optional<BestKnown> best_known() const override { return best_known_; }
+
+  FunctionProblem& set_initial_point(std::vector<double> x0);
+  FunctionProblem& set_best_known(BestKnown best);
+
+ private:
+  std::string name_;
+  std::vector<Variable> variables_;
+  Function function_;
+  std::vector<std::string> inequality_names_;
+  std::vector<std::string> equality_names_;
+  std::vector<double> initial_point_;
+  std::optional<BestKnown> best_known_;
+};
+
+// ---- The central checks (all throw abuopt::ConfigError with both values in the message) ----
+
+// The problem's own definition: at least one variable; names non-empty and unique; bounds finite
+// with lower < upper ("variable x[0] (a): lower bound 3 is not below upper bound 1"); scale > 0.
+void check_problem(const Problem& problem);
+
+// Size, NaN and bounds of a design vector:
+//   "<what>: the problem has 5 variables, the design vector has 4"
+//   "<what>: x[2] (dt2) = 12 is above its upper bound 10"
+//   "<what>: x[1] (dt1) = nan is not a number"
+// `what` names the vector in messages (e.g. "starting point", "optimizer.x0").
+void check_design_vector(const std::vector<Variable>& variables, const std::vector<double>& x,
+                         const std::string& what = "design vector");
+void check_design_vector(const Problem& problem, const std::vector<double>& x,
+                         const std::string& what = "design vector");
+
+// The shape of an evaluation against the problem's declared constraints ("the problem declares 2
+// inequality constraints, the evaluation returned 1"); throws std::logic_error (a defect).
+void check_evaluation_shape(std::size_t n_inequality, std::size_t n_equality, const Evaluation& e);
+
+// x clipped into the bounds (entries that are NaN are left NaN).
+std::vector<double> clip_to_bounds(const std::vector<Variable>& variables, std::vector<double> x);
+
+// ---- Scaling helpers ----
+// [lower, upper] <-> [0, 1]
+std::vector<double> to_unit_box(const std::vector<Variable>& variables, const std::vector<double>& x);
+std::vector<double> from_unit_box(const std::vector<Variable>& variables, const std::vector<double>& u);
+// x <-> x / scale
+std::vector<double> to_unit_scale(const std::vector<Variable>& variables, const std::vector<double>& x);
+std::vector<double> from_unit_scale(const std::vector<Variable>& variables, const std::vector<double>& y);
+
+// Largest constraint violation: max(0, max_i g_i, max_j |h_j|); +inf for a failed evaluation.
+double max_constraint_violation(const Evaluation& e);
+// ok, finite objective and violation <= tolerance.
+bool is_feasible(const Evaluation& e, double constraint_tolerance);
+
+// Shortest text that reads back as the same double ("0.1", "12", "1.0000000000000002").
+std::string format_number(double v);
+
+}  // namespace abuopt::opt

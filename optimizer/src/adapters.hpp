@@ -1,0 +1,26 @@
+#pragma once
+// Internal: the algorithm adapters behind minimize(). Each runs its library through the
+// EvaluationDriver and reports why the library stopped.
+#include <string>
+#include <vector>
+
+#include "abuopt/optimizer/algorithms.hpp"
+#include "evaluation_driver.hpp"
+
+namespace abuopt::opt::detail {
+
+struct AdapterOutcome {
+  TerminationReason reason = TerminationReason::failure;
+  std::string message;
+  std::string algorithm_label;  // e.g. "AUGLAG(BOBYQA)"
+  long iterations = 0;
+};
+
+// `x0` in real units, inside the bounds. `local` is used for AUGLAG / MLSL_LDS and for wrapping a
+// bound-only local algorithm in AUGLAG (wrap == true).
+AdapterOutcome run_nlopt(EvaluationDriver& driver, const AlgorithmInfo& algorithm, const AlgorithmInfo* local,
+                         bool wrap_in_auglag, const OptimizerOptions& options, const std::vector<double>& x0);
+
+AdapterOutcome run_ipopt(EvaluationDriver& driver, const OptimizerOptions& options, const std::vector<double>& x0);
+
+}  // namespace abuopt::opt::detail

@@ -1,0 +1,280 @@
+#include "evaluation_driver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <limits>
+
+namespace abuopt::opt::detail {
+
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+}
+
+std::atomic<bool>& interrupt_flag() noexcept {
+  static std::atomic<bool> flag{false};
+  return flag;
+}
+
+EvaluationDriver::EvaluationDriver(Problem& problem, const OptimizerOptions& options,
+                                   const EvaluationCallback& callback)
+    : problem_(problem),
+      options_(options),
+      callback_(callback),
+      variables_(problem.variables()),
+      n_ineq_(problem.inequality_names().size()),
+      n_eq_(problem.equality_names().size()),
+      start_(std::chrono::steady_clock::now()) {
+  for (const Variable& v : variables_) {
+    lower_y_.push_back(v.lower / v.scale);
+    upper_y_.push_back(v.upper / v.scale);
+  }
+  const double eps = std::numeric_limits<double>::epsilon();
+  fd_step_ = options.fd_relative_step > 0 ? options.fd_relative_step
+             : options.finite_difference == FiniteDifference::central ? std::cbrt(eps)
+                                                                        : std::sqrt(eps);
+}
+
+std::vector<double> EvaluationDriver::to_scaled(const std::vector<double>& x) const {
+  return to_unit_scale(variables_, x);
+}
+
+double EvaluationDriver::elapsed_s() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
+void EvaluationDriver::stop(TerminationReason reason, std::string message) {
+  if (stop_reason_) return;  // the first reason wins
+  stop_reason_ = reason;
+  stop_message_ = std::move(message);
+}
+
+bool EvaluationDriver::check_limits() {
+  if (stop_reason_) return true;
+  if (interrupt_flag().load()) {
+    stop(TerminationReason::interrupted, "interrupted (SIGINT or request_stop) after " +
+                                             std::to_string(evaluations_) + " evaluations");
+  } else if (evaluations_ >= options_.max_evaluations) {
+    stop(TerminationReason::max_evaluations,
+         "evaluation budget of " + std::to_string(options_.max_evaluations) + " used up");
+  } else if (options_.max_time_s > 0 && elapsed_s() >= options_.max_time_s) {
+    stop(TerminationReason::max_time, "time limit of " + format_number(options_.max_time_s) + " s reached");
+  }
+  return stop_reason_.has_value();
+}
+
+const EvaluatedPoint* EvaluationDriver::evaluate(const double* y, bool for_gradient) {
+  const std::size_t n = variables_.size();
+  std::vector<double> x(n);
+  bool clipped = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Variable& v = variables_[i];
+    double xi = std::isnan(y[i]) ? 0.5 * (v.lower + v.upper) : y[i] * v.scale;
+    const double slack = 1e-12 * (v.upper - v.lower);
+    if (xi < v.lower) {
+      clipped |= xi < v.lower - slack || std::isnan(y[i]);
+      xi = v.lower;
+    } else if (xi > v.upper) {
+      clipped |= xi > v.upper + slack || std::isnan(y[i]);
+      xi = v.upper;
+    } else if (std::isnan(y[i])) {
+      clipped = true;
+    }
+    x[i] = xi;
+  }
+  if (auto it = index_.find(x); it != index_.end()) {
+    ++repeats_;
+    return &points_[it->second];
+  }
+  if (check_limits()) return nullptr;
+  if (clipped) ++clipped_;
+
+  EvaluatedPoint p;
+  p.x = x;
+  bool threw = false;
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    p.e = problem_.evaluate(x);
+    check_evaluation_shape(n_ineq_, n_eq_, p.e);
+  } catch (const std::exception& ex) {
+    p.e = Evaluation::failed(std::string("evaluation threw: ") + ex.what());
+    threw = true;
+  } catch (...) {
+    p.e = Evaluation::failed("evaluation threw a non-standard exception");
+    threw = true;
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!p.e.ok) p.e.objective = kInf;
+  if (std::isnan(p.e.objective)) {
+    p.e.ok = false;
+    p.e.objective = kInf;
+    if (p.e.message.empty()) p.e.message = "objective is NaN";
+  }
+  p.violation = max_constraint_violation(p.e);
+  p.feasible = is_feasible(p.e, options_.constraint_tolerance);
+
+  ++evaluations_;
+  if (p.e.from_archive) ++archive_hits_;
+  if (!p.e.ok) ++failed_;
+  if (for_gradient) ++gradient_evals_;
+
+  points_.push_back(std::move(p));
+  const std::size_t idx = points_.size() - 1;
+  index_.emplace(x, idx);
+  const EvaluatedPoint& stored = points_.back();
+
+  // best: feasible with lowest f; else the smallest violation among ok points; else anything.
+  auto better = [&](const EvaluatedPoint& a, const EvaluatedPoint& b) {
+    if (a.feasible != b.feasible) return a.feasible;
+    if (a.feasible) return a.e.objective < b.e.objective;
+    if (a.e.ok != b.e.ok) return a.e.ok;
+    return a.violation < b.violation;
+  };
+  if (!best_ || better(stored, points_[*best_])) best_ = idx;
+
+  EvaluationRecord rec;
+  rec.index = evaluations_ - 1;
+  rec.x = stored.x;
+  rec.objective = stored.e.objective;
+  rec.inequality = stored.e.inequality;
+  rec.equality = stored.e.equality;
+  rec.metrics = stored.e.metrics;
+  rec.ok = stored.e.ok;
+  rec.feasible = stored.feasible;
+  rec.max_violation = stored.violation;
+  rec.from_archive = stored.e.from_archive;
+  rec.for_gradient = for_gradient;
+  rec.wall_time_s = wall;
+  rec.elapsed_s = elapsed_s();
+  rec.message = stored.e.message;
+
+  if (threw) stop(TerminationReason::evaluation_error, stored.e.message + " (at evaluation " +
+                                                           std::to_string(rec.index) + ")");
+  const EvaluatedPoint& best = points_[*best_];
+  if (options_.target && best.feasible && best.e.objective <= *options_.target)
+    stop(TerminationReason::target_reached,
+         "a feasible point reached f = " + format_number(best.e.objective) + " <= target " +
+             format_number(*options_.target));
+  if (callback_) {
+    Progress progress{rec, evaluations_, archive_hits_, rec.elapsed_s, best.feasible,
+                      best.feasible ? best.e.objective : kInf};
+    try {
+      if (!callback_(progress)) stop(TerminationReason::stopped_by_callback, "the callback asked to stop");
+    } catch (const std::exception& ex) {
+      stop(TerminationReason::stopped_by_callback, std::string("the callback threw: ") + ex.what());
+    }
+  }
+  if (interrupt_flag().load())
+    stop(TerminationReason::interrupted,
+         "interrupted (SIGINT or request_stop) after " + std::to_string(evaluations_) + " evaluations");
+  if (options_.keep_history) history_.push_back(std::move(rec));
+  return &stored;
+}
+
+bool EvaluationDriver::derivatives(const double* y_in, const EvaluatedPoint& base, double* grad_f, double* jac_ineq,
+                                   double* jac_eq) {
+  const std::size_t n = variables_.size();
+  auto zero = [&](std::size_t j) {
+    if (grad_f) grad_f[j] = 0.0;
+    for (std::size_t i = 0; jac_ineq && i < n_ineq_; ++i) jac_ineq[i * n + j] = 0.0;
+    for (std::size_t i = 0; jac_eq && i < n_eq_; ++i) jac_eq[i * n + j] = 0.0;
+  };
+  if (!base.e.ok) {
+    for (std::size_t j = 0; j < n; ++j) zero(j);
+    return !stopped();
+  }
+  // the base point clipped into the (scaled) bounds, as it was evaluated
+  std::vector<double> yc(y_in, y_in + n);
+  for (std::size_t j = 0; j < n; ++j) yc[j] = std::min(std::max(yc[j], lower_y_[j]), upper_y_[j]);
+  const double* y = yc.data();
+  std::vector<double> yp(yc);
+  // Evaluates the neighbour y + delta * e_j (delta may be negative); nullptr if stopped.
+  auto neighbour = [&](std::size_t j, double delta, double& actual) -> const EvaluatedPoint* {
+    yp[j] = y[j] + delta;
+    actual = yp[j] - y[j];  // the step actually taken in floating point
+    const EvaluatedPoint* p = evaluate(yp.data(), true);
+    yp[j] = y[j];
+    return p;
+  };
+  auto set = [&](std::size_t j, const EvaluatedPoint& a, const EvaluatedPoint& b, double dy) {
+    // derivative = (a - b) / dy
+    if (grad_f) grad_f[j] = (a.e.objective - b.e.objective) / dy;
+    for (std::size_t i = 0; jac_ineq && i < n_ineq_; ++i)
+      jac_ineq[i * n + j] = (a.e.inequality[i] - b.e.inequality[i]) / dy;
+    for (std::size_t i = 0; jac_eq && i < n_eq_; ++i) jac_eq[i * n + j] = (a.e.equality[i] - b.e.equality[i]) / dy;
+  };
+  for (std::size_t j = 0; j < n; ++j) {
+    const double h = fd_step_ * std::max(std::fabs(y[j]), 1.0);
+    const bool room_up = y[j] + h <= upper_y_[j];
+    const bool room_down = y[j] - h >= lower_y_[j];
+    double up = 0, down = 0;
+    if (options_.finite_difference == FiniteDifference::central && room_up && room_down) {
+      const EvaluatedPoint* a = neighbour(j, h, up);
+      if (!a) return false;
+      const EvaluatedPoint* b = neighbour(j, -h, down);
+      if (!b) return false;
+      if (a->e.ok && b->e.ok) {
+        set(j, *a, *b, up - down);
+        continue;
+      }
+      if (a->e.ok) set(j, *a, base, up);
+      else if (b->e.ok) set(j, base, *b, -down);
+      else zero(j);
+      continue;
+    }
+    // one-sided: forward if there is room above, else backward
+    double delta = h;
+    if (!room_up && room_down) delta = -h;
+    if (!room_up && !room_down)  // a box narrower than the step: go to the farther bound
+      delta = upper_y_[j] - y[j] >= y[j] - lower_y_[j] ? upper_y_[j] - y[j] : lower_y_[j] - y[j];
+    if (delta == 0.0) {
+      zero(j);
+      continue;
+    }
+    double actual = 0;
+    const EvaluatedPoint* a = neighbour(j, delta, actual);
+    if (!a) return false;
+    if (a->e.ok && actual != 0.0) {
+      if (actual > 0) set(j, *a, base, actual);
+      else set(j, base, *a, -actual);
+      continue;
+    }
+    // the neighbour failed: try the other side
+    const double other = -delta;
+    if ((other > 0 && y[j] + other <= upper_y_[j]) || (other < 0 && y[j] + other >= lower_y_[j])) {
+      const EvaluatedPoint* b = neighbour(j, other, actual);
+      if (!b) return false;
+      if (b->e.ok && actual != 0.0) {
+        if (actual > 0) set(j, *b, base, actual);
+        else set(j, base, *b, -actual);
+        continue;
+      }
+    }
+    zero(j);
+  }
+  return !stopped();
+}
+
+void EvaluationDriver::fill(OptimizationResult& r) const {
+  r.evaluations = evaluations_;
+  r.archive_hits = archive_hits_;
+  r.failed_evaluations = failed_;
+  r.gradient_evaluations = gradient_evals_;
+  r.repeated_requests = repeats_;
+  r.clipped_requests = clipped_;
+  r.wall_time_s = elapsed_s();
+  r.constraint_tolerance = options_.constraint_tolerance;
+  if (best_) {
+    const EvaluatedPoint& b = points_[*best_];
+    r.x = b.x;
+    r.objective = b.e.objective;
+    r.inequality = b.e.inequality;
+    r.equality = b.e.equality;
+    r.metrics = b.e.metrics;
+    r.feasible = b.feasible;
+    r.max_violation = b.violation;
+  }
+  r.history = history_;
+}
+
+}  // namespace abuopt::opt::detail

@@ -1,0 +1,80 @@
+#pragma once
+// Internal: the one wrapper through which every adapter evaluates the problem (see minimize.hpp).
+// Adapters work in scaled coordinates y = x / scale; the driver maps back, clips into the bounds,
+// caches, counts, enforces the budget and records the best point.
+#include <atomic>
+#include <chrono>
+#include <deque>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "abuopt/optimizer/minimize.hpp"
+
+namespace abuopt::opt::detail {
+
+// Set by the SIGINT handler and request_stop().
+std::atomic<bool>& interrupt_flag() noexcept;
+
+struct EvaluatedPoint {
+  std::vector<double> x;  // real units, inside the bounds
+  Evaluation e;
+  double violation = 0.0;
+  bool feasible = false;
+};
+
+class EvaluationDriver {
+ public:
+  EvaluationDriver(Problem& problem, const OptimizerOptions& options, const EvaluationCallback& callback);
+
+  std::size_t n() const { return variables_.size(); }
+  std::size_t n_inequality() const { return n_ineq_; }
+  std::size_t n_equality() const { return n_eq_; }
+  const std::vector<double>& lower_scaled() const { return lower_y_; }
+  const std::vector<double>& upper_scaled() const { return upper_y_; }
+  std::vector<double> to_scaled(const std::vector<double>& x) const;
+
+  // Evaluates at scaled point y (length n). Returns nullptr, without evaluating, once the run is
+  // stopped (budget, time, interrupt, callback, error). The pointer stays valid for the run.
+  const EvaluatedPoint* evaluate(const double* y, bool for_gradient = false);
+
+  // Finite-difference derivatives in scaled coordinates at y, whose evaluation is `base`:
+  // grad_f (n), jac_ineq (n_inequality x n, row-major), jac_eq (n_equality x n); any may be null.
+  // Returns false if the run stopped meanwhile (the outputs are then partial).
+  bool derivatives(const double* y, const EvaluatedPoint& base, double* grad_f, double* jac_ineq, double* jac_eq);
+
+  bool stopped() const { return stop_reason_.has_value(); }
+  std::optional<TerminationReason> stop_reason() const { return stop_reason_; }
+  const std::string& stop_message() const { return stop_message_; }
+  void stop(TerminationReason reason, std::string message);
+
+  long evaluations() const { return evaluations_; }
+  double elapsed_s() const;
+
+  // Fills the counts, best point and history of `r` (reason and message are the caller's).
+  void fill(OptimizationResult& r) const;
+
+ private:
+  bool check_limits();  // sets the stop reason when a limit is reached; true if stopped
+
+  Problem& problem_;
+  const OptimizerOptions& options_;
+  const EvaluationCallback& callback_;
+  std::vector<Variable> variables_;
+  std::size_t n_ineq_ = 0, n_eq_ = 0;
+  std::vector<double> lower_y_, upper_y_;
+  double fd_step_;
+  std::chrono::steady_clock::time_point start_;
+
+  std::deque<EvaluatedPoint> points_;
+  std::map<std::vector<double>, std::size_t> index_;  // x (real units) -> points_
+  std::optional<std::size_t> best_;
+  std::vector<EvaluationRecord> history_;
+
+  long evaluations_ = 0, archive_hits_ = 0, failed_ = 0, gradient_evals_ = 0, repeats_ = 0, clipped_ = 0;
+  std::optional<TerminationReason> stop_reason_;
+  std::string stop_message_;
+};
+
+}  // namespace abuopt::opt::detail

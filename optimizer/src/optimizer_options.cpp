@@ -1,0 +1,78 @@
+#include "abuopt/optimizer/optimizer_options.hpp"
+
+#include <cmath>
+
+#include "abuopt/common/config_error.hpp"
+#include "abuopt/optimizer/algorithms.hpp"
+#include "abuopt/optimizer/problem.hpp"
+
+namespace abuopt::opt {
+
+std::string to_string(FiniteDifference kind) {
+  return kind == FiniteDifference::central ? "central" : "forward";
+}
+
+namespace {
+void require(bool ok, const std::string& key, double value, const std::string& rule) {
+  if (!ok) throw ConfigError("optimizer." + key, format_number(value), rule);
+}
+}  // namespace
+
+void OptimizerOptions::validate() const {
+  const AlgorithmInfo& info = find_algorithm(algorithm, "optimizer.algorithm");
+  if (!local_algorithm.empty()) {
+    const AlgorithmInfo& local = find_algorithm(local_algorithm, "optimizer.local_algorithm");
+    if (local.family != AlgorithmFamily::local_derivative_free && local.family != AlgorithmFamily::local_gradient)
+      throw ConfigError("optimizer.local_algorithm", local_algorithm, "must be a local algorithm (not global or AUGLAG)");
+    if (local.name == "IPOPT")
+      throw ConfigError("optimizer.local_algorithm", local_algorithm, "IPOPT cannot be a local algorithm of NLopt");
+  }
+  (void)info;
+  require(max_evaluations > 0, "max_evaluations", static_cast<double>(max_evaluations), "must be > 0");
+  require(std::isfinite(max_time_s) && max_time_s >= 0, "max_time_s", max_time_s, "must be >= 0 (0: no limit)");
+  require(max_iterations >= 0, "max_iterations", static_cast<double>(max_iterations), "must be >= 0 (0: default)");
+  require(std::isfinite(xtol_rel) && xtol_rel >= 0, "xtol_rel", xtol_rel, "must be >= 0");
+  require(std::isfinite(ftol_rel) && ftol_rel >= 0, "ftol_rel", ftol_rel, "must be >= 0");
+  require(std::isfinite(ftol_abs) && ftol_abs >= 0, "ftol_abs", ftol_abs, "must be >= 0");
+  if (target) require(!std::isnan(*target), "target", *target, "must be a number");
+  require(std::isfinite(constraint_tolerance) && constraint_tolerance >= 0, "constraint_tolerance",
+          constraint_tolerance, "must be >= 0");
+  require(std::isfinite(fd_relative_step) && fd_relative_step >= 0 && fd_relative_step < 0.5, "fd_relative_step",
+          fd_relative_step, "must be in [0, 0.5) (0: automatic)");
+  require(population >= 0, "population", static_cast<double>(population), "must be >= 0 (0: default)");
+  require(std::isfinite(initial_step) && initial_step >= 0 && initial_step <= 1, "initial_step", initial_step,
+          "must be in [0, 1] (a fraction of each variable's range; 0: automatic)");
+  require(print_level >= 0 && print_level <= 12, "print_level", print_level, "must be in [0, 12]");
+}
+
+OptimizerOptions read_optimizer_options(YamlReader& r) {
+  OptimizerOptions o;
+  o.algorithm = r.get_string_or("algorithm", o.algorithm);
+  find_algorithm(o.algorithm, r.key_path("algorithm"));
+  o.local_algorithm = r.get_string_or("local_algorithm", o.local_algorithm);
+  if (!o.local_algorithm.empty()) find_algorithm(o.local_algorithm, r.key_path("local_algorithm"));
+  o.max_evaluations = r.get_int_or("max_evaluations", o.max_evaluations, Rule::positive());
+  o.max_time_s = r.get_double_or("max_time_s", o.max_time_s, Rule::non_negative());
+  o.max_iterations = r.get_int_or("max_iterations", o.max_iterations, Rule::non_negative());
+  o.xtol_rel = r.get_double_or("xtol_rel", o.xtol_rel, Rule::non_negative());
+  o.ftol_rel = r.get_double_or("ftol_rel", o.ftol_rel, Rule::non_negative());
+  o.ftol_abs = r.get_double_or("ftol_abs", o.ftol_abs, Rule::non_negative());
+  if (r.has("target")) o.target = r.get_double("target");
+  else r.get_double_or("target", 0.0);  // marks an explicit `target: null` as read
+  o.constraint_tolerance = r.get_double_or("constraint_tolerance", o.constraint_tolerance, Rule::non_negative());
+  o.finite_difference =
+      r.get_choice_or("finite_difference", "forward", {"forward", "central"}) == "central" ? FiniteDifference::central
+                                                                                          : FiniteDifference::forward;
+  o.fd_relative_step = r.get_double_or("fd_relative_step", o.fd_relative_step, Rule::in_range(0.0, 0.49));
+  o.seed = static_cast<unsigned long>(r.get_int_or("seed", static_cast<long>(o.seed), Rule::non_negative()));
+  o.population = r.get_int_or("population", o.population, Rule::non_negative());
+  o.initial_step = r.get_double_or("initial_step", o.initial_step, Rule::in_range(0.0, 1.0));
+  o.print_level = static_cast<int>(r.get_int_or("print_level", o.print_level, Rule::in_range(0, 12)));
+  o.handle_sigint = r.get_bool_or("handle_sigint", o.handle_sigint);
+  o.keep_history = r.get_bool_or("keep_history", o.keep_history);
+  r.finish();
+  o.validate();
+  return o;
+}
+
+}  // namespace abuopt::opt
