@@ -1,0 +1,117 @@
+#pragma once
+// Monte Carlo over initial ball angles (and optionally uncertain parameters) for one setup.
+//
+// Run i of a study is a pure function of (study, i):
+//   beta0     = point i of the initial-condition design (initial_conditions.hpp),
+//   overrides = sample_overrides(study.uncertain, setup.abu, study.seed, i) (hash of (seed, i)),
+//   outcome   = the per-sample function (by default Simulator::run) of (beta0, overrides).
+// The engine writes outcome i into slot i of a pre-sized vector, whatever worker ran it, so the
+// results are bit-identical for any thread count or batch backend, and run_one(study, i) replays
+// run i alone (the way to debug one odd sample of a large study).
+//
+// Numerical trouble inside one run is the outcome's status (counted by the statistics); an
+// exception thrown by the per-sample function (a bug, or a config error) aborts the study.
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "abuopt/common/yaml_reader.hpp"
+#include "abuopt/core/batch_runner.hpp"
+#include "abuopt/core/initial_conditions.hpp"
+#include "abuopt/core/outcome.hpp"
+#include "abuopt/core/simulator.hpp"
+#include "abuopt/core/uncertain_parameters.hpp"
+
+namespace abuopt {
+
+struct MonteCarloStudy {
+  SimulationSetup setup;
+  // Initial ball angles. The engine takes the number of balls from setup.abu.balls and, for every
+  // kind but Grid, the number of points from `runs` (see study_design()).
+  InitialConditionDesign design;
+  UncertainParameters uncertain;
+  std::uint64_t seed = 0;   // stream of the uncertain parameters (the design has its own seed)
+  std::size_t runs = 1024;  // Grid: must equal grid^balls
+};
+
+// The design the study actually uses: `design` with balls = setup.abu.balls.size() and, unless it
+// is a grid, count = runs.
+InitialConditionDesign study_design(const MonteCarloStudy& s);
+
+// Throws ConfigError (keys below `path`): runs < 1, grid^balls != runs, invalid design or
+// uncertain parameters, no balls.
+void validate(const MonteCarloStudy& s, const std::string& path = "montecarlo");
+
+// One run's inputs and result.
+struct MonteCarloSample {
+  std::size_t index = 0;
+  std::vector<double> beta0;  // initial ball angles [rad]
+  RunOverrides overrides;
+  double friction_mu = 0;     // effective mu of this run (override or nominal)
+  double imbalance_kgm = 0;   // effective m_I e of this run: the %MI threshold
+  RunOutcome outcome;
+};
+
+struct MonteCarloResult {
+  std::vector<MonteCarloSample> samples;  // samples[i].index == i
+  double wall_time_s = 0;
+  std::size_t concurrency = 1;            // workers of the batch runner
+};
+
+// The per-sample function: one startup from beta0 with the given overrides. Called from several
+// threads at once: it must be thread-safe and deterministic in its arguments.
+using SampleFunction = std::function<RunOutcome(const std::vector<double>& beta0, const RunOverrides& overrides)>;
+
+// The inputs of run `index` (outcome left default): for replaying or inspecting one run.
+MonteCarloSample prepare_sample(const MonteCarloStudy& s, std::size_t index);
+
+// The engine with an injected per-sample function (tests, other models, surrogate screening).
+MonteCarloResult run_monte_carlo(const MonteCarloStudy& s, const SampleFunction& sample, BatchRunner& runner,
+                                 const ProgressCallback& progress = {});
+
+// Run `index` alone with an injected per-sample function.
+MonteCarloSample run_one(const MonteCarloStudy& s, std::size_t index, const SampleFunction& sample);
+
+// --- Simulator-backed defaults ----------------------------------------------------------------
+// These are inline so that the engine's object file has no link-time dependency on the
+// simulator: programs that inject their own SampleFunction link without it.
+
+// A SampleFunction running Simulator::run on one shared, const Simulator (validates the setup:
+// throws ConfigError).
+inline SampleFunction simulator_sample_function(const SimulationSetup& setup) {
+  auto sim = std::make_shared<const Simulator>(setup);
+  return [sim](const std::vector<double>& beta0, const RunOverrides& o) { return sim->run(beta0, o); };
+}
+
+inline MonteCarloResult run_monte_carlo(const MonteCarloStudy& s, BatchRunner& runner,
+                                        const ProgressCallback& progress = {}) {
+  validate(s);
+  return run_monte_carlo(s, simulator_sample_function(s.setup), runner, progress);
+}
+
+inline MonteCarloSample run_one(const MonteCarloStudy& s, std::size_t index) {
+  validate(s);
+  return run_one(s, index, simulator_sample_function(s.setup));
+}
+
+// --- Configuration ----------------------------------------------------------------------------
+struct MonteCarloConfig {
+  MonteCarloStudy study;
+  std::size_t threads = 0;  // 0: all hardware threads
+};
+
+// Reads the `montecarlo` section of `root` (every key optional; docs/montecarlo.md):
+//   design: grid | random | lhs | halton | sobol   (default grid)
+//   grid: 32          points per axis of the grid design (grid^balls runs)
+//   runs: 1024        number of runs (grid: optional, must equal grid^balls)
+//   seed: 0           seeds the design and the uncertain parameters (whole number 0..2^53)
+//   shift: true       halton/sobol: Cranley-Patterson random shift from the seed
+//   threads: 0        0 = all cores
+//   friction: {...}, imbalance: {...}   (uncertain_parameters.hpp)
+// `setup` (read before, e.g. by read_simulation_setup) becomes study.setup. Validates the study.
+// The caller still calls root.finish().
+MonteCarloConfig read_monte_carlo_config(YamlReader& root, SimulationSetup setup);
+
+}  // namespace abuopt

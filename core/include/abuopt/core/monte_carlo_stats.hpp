@@ -1,0 +1,91 @@
+#pragma once
+// Statistics of a Monte Carlo study (spec section 5; formulas in docs/montecarlo.md).
+//
+// Failed runs (outcome status != Ok) are COUNTED (failed, per status) but EXCLUDED from every other
+// statistic: residual imbalance, %MI, %LC, settling time and amplitude are over the n_ok runs that
+// reached the end time. A failed run has no trustworthy final state; counting it as balanced or as
+// unbalanced would bias the figures either way, so the failure rate is reported next to them.
+// With n_ok = 0 the statistics are NaN (null in JSON) and the counts are 0.
+//
+// For each definition of the residual imbalance I_r (magnitude |I_r|, and the report's I_r,x):
+//   mean = (1/n) sum I_r, max, min, median and quantiles p10, p90, p95 with linear interpolation
+//   between order statistics (Hyndman & Fan type 7, the default of R and NumPy): for sorted
+//   x_0 <= ... <= x_{n-1} and probability p, h = (n - 1) p, Q(p) = x_{floor h} + (h - floor h)
+//   (x_{floor h + 1} - x_{floor h}).
+//   %MI = 100 k / n, k = #runs with I_r >= I, I = m_I e of that run (the imbalance without balls,
+//   AbuParameters::imbalance_kgm(), or the run's own m_I when the imbalance mass is uncertain),
+//   with its 95 % Wilson score interval (z = 1.959963984540054):
+//     centre = (p + z^2/(2n)) / (1 + z^2/n),  half = z / (1 + z^2/n) sqrt(p (1 - p)/n + z^2/(4 n^2))
+//   (in percent).
+// %LC = 100 (#ok runs not settled at the end time) / n_ok.
+// Settling time: mean, median, max over the settled ok runs. Amplitude: max and mean of
+// max_amplitude_mm over the ok runs.
+#include <array>
+#include <cstddef>
+#include <iosfwd>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "abuopt/core/monte_carlo.hpp"
+#include "abuopt/core/outcome.hpp"
+
+namespace abuopt {
+
+// Sample quantile, linear interpolation (type 7). `sorted` ascending and non-empty; 0 <= p <= 1.
+double quantile_type7(const std::vector<double>& sorted, double p);
+
+// 95 % (or other z) Wilson score interval of a proportion k/n, as fractions in [0, 1].
+// n = 0 gives {NaN, NaN}.
+std::pair<double, double> wilson_interval(std::size_t k, std::size_t n, double z = 1.959963984540054);
+
+struct ResidualImbalanceStats {
+  std::size_t count = 0;  // ok runs
+  double mean = 0, min = 0, max = 0, median = 0, p10 = 0, p90 = 0, p95 = 0;  // kg m
+  std::size_t mi_count = 0;                   // runs with I_r >= I
+  double pct_mi = 0;                          // 100 mi_count / count
+  std::array<double, 2> pct_mi_ci95{0, 0};    // Wilson score interval, percent
+};
+
+// Number of RunStatus values, and a stable snake_case key for each ("ok", "solver_failure",
+// "chatter_limit", "step_limit") used in JSON and CSV.
+inline constexpr std::size_t kRunStatusCount = 4;
+std::string status_key(RunStatus s);
+
+struct MonteCarloStats {
+  std::size_t runs = 0;
+  std::size_t ok = 0;
+  std::size_t failed = 0;                                  // status != Ok
+  std::array<std::size_t, kRunStatusCount> status_counts{};  // indexed by RunStatus
+  ResidualImbalanceStats magnitude;  // |I_r| (RunOutcome::residual_imbalance_kgm)
+  ResidualImbalanceStats report_x;   // I_r,x (RunOutcome::residual_imbalance_x_kgm), report eq 4.2
+  std::size_t not_settled = 0;       // ok runs not settled at the end time
+  double pct_lc = 0;                 // 100 not_settled / ok
+  std::size_t settled = 0;
+  double settling_mean_s = 0, settling_median_s = 0, settling_max_s = 0;
+  double amplitude_max_mm = 0, amplitude_mean_mm = 0;
+  double wall_time_s = 0;            // of the study (0 when computed from bare samples)
+  std::size_t concurrency = 0;
+};
+
+MonteCarloStats compute_statistics(const std::vector<MonteCarloSample>& samples);
+MonteCarloStats compute_statistics(const MonteCarloResult& result);  // adds wall time, concurrency
+
+// The summary as one JSON object: runs, ok, failed, status_counts {key: n}, pct_lc, not_settled,
+// wall_time_s, concurrency, magnitude {...}, report_x {...} (count, mean, min, max, median, p10,
+// p90, p95, mi_count, pct_mi, pct_mi_ci95 [lo, hi]), settling_time_s {settled, mean, median, max},
+// max_amplitude_mm {max, mean}, quantile_definition. NaN becomes null.
+nlohmann::json to_json(const MonteCarloStats& s);
+
+// Human-readable multi-line summary (both definitions, kg m in units of 1e-7 as in the report).
+std::string format_summary(const MonteCarloStats& s);
+
+// Per-run CSV: header, then one line per sample in index order. Columns:
+// index, beta0_1..beta0_N, mu, imbalance_mass_kg (empty when nominal), imbalance_angle_rad,
+// beta_final_1..beta_final_N, ir_magnitude_kgm, ir_x_kgm, settled, settling_time_s,
+// max_amplitude_mm, events, rhs_evaluations, status. Numbers round-trip exactly (shortest form).
+void write_runs_csv(std::ostream& os, const std::vector<MonteCarloSample>& samples);
+
+}  // namespace abuopt
