@@ -29,6 +29,7 @@ struct Factorisation {
   Eigen::VectorXd alpha;
   double sigma2 = 0.0;
   double log_likelihood = kNegativeInfinity;
+  double reciprocal_condition = 0.0;  // LLT estimate of 1 / cond_1(R)
 };
 
 Eigen::MatrixXd correlation_matrix(const Eigen::MatrixXd& X,
@@ -60,6 +61,7 @@ Factorisation factorise(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
     if (!(d > 0.0) || !std::isfinite(d)) return f;
     log_det += 2.0 * std::log(d);
   }
+  f.reciprocal_condition = f.llt.rcond();
   f.r_inv_ones = f.llt.solve(Eigen::VectorXd::Ones(m));
   f.ones_r_inv_ones = f.r_inv_ones.sum();
   if (!(f.ones_r_inv_ones > 0.0) || !std::isfinite(f.ones_r_inv_ones)) return f;
@@ -101,6 +103,9 @@ void validate(const KrigingOptions& o, int n) {
     fail("max_length_scale = " + std::to_string(o.max_length_scale) +
          ": must be finite and > min_length_scale = " + std::to_string(o.min_length_scale));
   }
+  if (!(o.max_condition_number >= 1.0)) {
+    fail("max_condition_number = " + std::to_string(o.max_condition_number) + ": must be >= 1");
+  }
   if (o.starts < 1) fail("starts = " + std::to_string(o.starts) + ": must be >= 1");
   if (o.max_evaluations < 10) {
     fail("max_evaluations = " + std::to_string(o.max_evaluations) + ": must be >= 10");
@@ -126,6 +131,7 @@ struct LikelihoodProblem {
   int n = 0;
   bool estimate_nugget = false;
   double fixed_nugget = 0.0;
+  double max_condition_number = 0.0;
   int evaluations = 0;
   double best = kNegativeInfinity;
   std::vector<double> best_z;
@@ -136,7 +142,16 @@ struct LikelihoodProblem {
     for (int k = 0; k < n; ++k) scales[k] = std::exp(z[static_cast<std::size_t>(k)]);
     const double nugget =
         estimate_nugget ? std::exp(z[static_cast<std::size_t>(n)]) : fixed_nugget;
-    const double value = factorise(*X, *y, inverse_squares(scales), nugget).log_likelihood;
+    const Factorisation f = factorise(*X, *y, inverse_squares(scales), nugget);
+    double value = f.log_likelihood;
+    // Smooth barrier beyond the condition-number cap: ln L - m (log10(cond / cap))^2. Without
+    // it, smooth data drive the length scales up until R is singular to working precision and
+    // r^T alpha loses most of its digits.
+    const double excess =
+        std::log10(max_condition_number * std::max(f.reciprocal_condition, 1e-300));
+    if (std::isfinite(value) && excess < 0.0) {
+      value -= static_cast<double>(X->rows()) * excess * excess;
+    }
     if (value > best) {
       best = value;
       best_z = z;
@@ -233,6 +248,7 @@ void Kriging::fit(const Eigen::MatrixXd& X, const Eigen::VectorXd& y) {
     problem.n = n;
     problem.estimate_nugget = options_.estimate_nugget;
     problem.fixed_nugget = options_.nugget;
+    problem.max_condition_number = options_.max_condition_number;
     for (auto& z : starts) {
       nlopt::opt opt(nlopt::LN_BOBYQA, static_cast<unsigned>(vars));
       opt.set_lower_bounds(lo);

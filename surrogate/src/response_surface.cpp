@@ -87,7 +87,12 @@ std::vector<std::string> term_names(Basis basis, int n) {
   std::vector<std::string> names;
   names.reserve(static_cast<std::size_t>(terms_count(basis, n)));
   names.emplace_back("1");
-  const auto var = [](int i) { return "x" + std::to_string(i); };
+  // Built by append(): `"x" + std::to_string(i)` trips GCC 12's false -Wrestrict (PR 105329).
+  const auto var = [](int i) {
+    std::string name("x");
+    name.append(std::to_string(i));
+    return name;
+  };
   for (int i = 0; i < n; ++i) names.push_back(var(i));
   if (has_squares(basis)) {
     for (int i = 0; i < n; ++i) names.push_back(var(i) + "^2");

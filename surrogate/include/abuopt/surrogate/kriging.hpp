@@ -13,7 +13,8 @@
 // The length scales (and optionally lambda) maximise ln L, over log l_k in
 // [ln(min_length_scale * span_k), ln(max_length_scale * span_k)], span_k = the range of the
 // training points in variable k; NLopt LN_BOBYQA from `starts` starting points (the first is
-// initial_length_scales or 0.5 span_k, the others a seeded Latin hypercube in log space).
+// initial_length_scales or 0.5 span_k, the others a seeded Latin hypercube in log space), with
+// a soft penalty keeping cond(R) near max_condition_number (see KrigingOptions).
 // Prediction (alpha = R^-1 (y - mu 1), computed once by a Cholesky factorisation R = L L^T):
 //   yhat(x)      = mu + r(x)^T alpha
 //   d yhat/dx_k  = - sum_i alpha_i r_i(x) (x_k - x_ik) / l_k^2
@@ -47,6 +48,11 @@ struct KrigingOptions {
   // Bounds of the length scales as fractions of each variable's span.
   double min_length_scale = 1e-2;  // relative to span_k
   double max_length_scale = 1e1;   // relative to span_k
+  // Soft cap on the condition number of R during the likelihood search: beyond it the searched
+  // objective is ln L - m (log10(cond / cap))^2 (smooth data otherwise push the length scales
+  // until R is numerically singular and predictions lose their digits). cond is the LLT::rcond
+  // estimate; the reported log_likelihood() is always the unpenalised ln L.
+  double max_condition_number = 1e8;
   int starts = 4;                  // optimiser starting points (>= 1)
   int max_evaluations = 400;       // likelihood evaluations per start (>= 10)
   std::uint64_t seed = 0;          // seed of the extra starting points (std::mt19937_64)
