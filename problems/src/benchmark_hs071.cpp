@@ -1,0 +1,25 @@
+#include "abuopt/problems/benchmarks/hs071.hpp"
+
+namespace abuopt::problems {
+
+std::vector<opt::Variable> Hs071::variables() const {
+  return {{"x1", 1, 5, 1}, {"x2", 1, 5, 1}, {"x3", 1, 5, 1}, {"x4", 1, 5, 1}};
+}
+
+opt::Evaluation Hs071::evaluate(const std::vector<double>& x) {
+  opt::check_design_vector(variables(), x);
+  opt::Evaluation e;
+  e.objective = x[0] * x[3] * (x[0] + x[1] + x[2]) + x[2];
+  const double product = x[0] * x[1] * x[2] * x[3];
+  e.inequality = {25.0 - product};
+  e.equality = {x[0] * x[0] + x[1] * x[1] + x[2] * x[2] + x[3] * x[3] - 40.0};
+  e.metrics["product"] = product;
+  return e;
+}
+
+std::optional<opt::BestKnown> Hs071::best_known() const {
+  // Ipopt's published solution of its tutorial problem (KKT-checked in tests/problems).
+  return opt::BestKnown{{1.0, 4.742999643, 3.821149978, 1.379408293}, 17.014017145};
+}
+
+}  // namespace abuopt::problems
