@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "abuopt 0.1.0");
   abuopt::app::register_simulate(app);
+  abuopt::app::register_montecarlo(app);
 
   try {
     app.parse(argc, argv);

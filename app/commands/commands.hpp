@@ -10,5 +10,6 @@ void set_exit_code(int code);
 int exit_code();
 
 void register_simulate(CLI::App& app);
+void register_montecarlo(CLI::App& app);
 
 }  // namespace abuopt::app

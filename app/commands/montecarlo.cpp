@@ -1,0 +1,222 @@
+// abuopt montecarlo CONFIG: Monte Carlo over initial ball angles (and uncertain parameters) for one
+// startup profile; prints the statistics of both residual-imbalance definitions.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "abuopt/common/config_error.hpp"
+#include "abuopt/core/monte_carlo.hpp"
+#include "abuopt/core/monte_carlo_stats.hpp"
+#include "abuopt/core/simulation_config.hpp"
+#include "commands/commands.hpp"
+
+namespace abuopt::app {
+
+namespace {
+
+struct MonteCarloArgs {
+  std::string config;
+  std::optional<long> runs, grid, threads;
+  std::optional<long long> seed;
+  std::optional<double> mu;
+  std::optional<std::string> design;
+  bool json = false;
+  std::string out;
+};
+
+std::string num_text(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+
+// Applies the command-line options over the config; each bad value names its option.
+void apply_overrides(const MonteCarloArgs& a, MonteCarloConfig& cfg) {
+  MonteCarloStudy& s = cfg.study;
+  if (a.design) s.design.kind = initial_condition_kind_from_string(*a.design, "--design");
+  if (a.grid) {
+    if (*a.grid < 1) throw ConfigError("--grid", std::to_string(*a.grid), "must be >= 1 (points per axis)");
+    if (!a.design) s.design.kind = InitialConditionKind::Grid;
+    s.design.grid_points_per_axis = static_cast<std::size_t>(*a.grid);
+  }
+  if (a.runs && *a.runs < 1) throw ConfigError("--runs", std::to_string(*a.runs), "must be >= 1");
+  if (a.threads && *a.threads < 0)
+    throw ConfigError("--threads", std::to_string(*a.threads), "must be >= 0 (0 = all cores)");
+  if (a.seed && *a.seed < 0) throw ConfigError("--seed", std::to_string(*a.seed), "must be >= 0");
+  if (a.mu && !(std::isfinite(*a.mu) && *a.mu >= 0 && *a.mu < 1))
+    throw ConfigError("--mu", num_text(*a.mu), "must be in [0, 1) (a friction coefficient)");
+
+  const InitialConditionDesign d = study_design(s);
+  if (a.runs) {
+    s.runs = static_cast<std::size_t>(*a.runs);
+    if (s.design.kind == InitialConditionKind::Grid && d.size() != s.runs)
+      throw ConfigError("--runs", std::to_string(*a.runs),
+                        "must equal grid^balls = " + std::to_string(d.grid_points_per_axis) + "^" +
+                            std::to_string(d.balls) + " = " + std::to_string(d.size()) +
+                            " with the grid design (use --grid, or --design random|lhs|halton|sobol)");
+  } else if (s.design.kind == InitialConditionKind::Grid) {
+    if (d.size() > kMaxDesignPoints)
+      throw ConfigError(a.grid ? "--grid" : "montecarlo.grid", std::to_string(d.grid_points_per_axis),
+                        "grid^balls (balls = " + std::to_string(d.balls) + ") must be <= 2^32 runs");
+    s.runs = d.size();
+  }
+  if (a.threads) cfg.threads = static_cast<std::size_t>(*a.threads);
+  if (a.seed) {
+    s.seed = static_cast<std::uint64_t>(*a.seed);
+    s.design.seed = s.seed;
+  }
+  if (a.mu) {
+    s.uncertain.friction = FrictionUncertainty{};
+    s.uncertain.friction.sampling = FrictionSampling::Fixed;
+    s.uncertain.friction.value = *a.mu;
+  }
+  validate(s);
+}
+
+std::string friction_text(const MonteCarloStudy& s) {
+  const FrictionUncertainty& f = s.uncertain.friction;
+  switch (f.sampling) {
+    case FrictionSampling::Nominal: return num_text(s.setup.abu.friction_mu);
+    case FrictionSampling::Fixed: return num_text(f.value);
+    case FrictionSampling::List: {
+      std::string t = "list [";
+      for (std::size_t i = 0; i < f.values.size(); ++i) t += (i ? ", " : "") + num_text(f.values[i]);
+      return t + "] (cycled)";
+    }
+    case FrictionSampling::Range: return "uniform [" + num_text(f.lo) + ", " + num_text(f.hi) + "]";
+  }
+  return "?";
+}
+
+nlohmann::json study_json(const MonteCarloArgs& a, const MonteCarloConfig& cfg, double end_time_s) {
+  const MonteCarloStudy& s = cfg.study;
+  const InitialConditionDesign d = study_design(s);
+  nlohmann::json j = {{"config", a.config},
+                      {"design", to_string(d.kind)},
+                      {"balls", d.balls},
+                      {"runs", s.runs},
+                      {"seed", s.seed},
+                      {"friction", friction_text(s)},
+                      {"imbalance_mass", to_string(s.uncertain.imbalance_mass.sampling)},
+                      {"imbalance_angle", to_string(s.uncertain.imbalance_angle.sampling)},
+                      {"imbalance_without_balls_kgm", s.setup.abu.imbalance_kgm()},
+                      {"profile_duration_s", s.setup.profile.duration_s()},
+                      {"end_time_s", end_time_s}};
+  if (d.kind == InitialConditionKind::Grid) j["grid"] = d.grid_points_per_axis;
+  if (d.kind == InitialConditionKind::Halton || d.kind == InitialConditionKind::Sobol) j["shift"] = d.random_shift;
+  return j;
+}
+
+// A one-line progress bar on stderr, redrawn at most every 0.1 s: runs done, rate, ETA.
+class ProgressBar {
+ public:
+  void operator()(std::size_t done, std::size_t total, double elapsed) {
+    if (done < total && elapsed - last_ < 0.1) return;
+    last_ = elapsed;
+    const double frac = total ? static_cast<double>(done) / static_cast<double>(total) : 1.0;
+    const int width = 30, filled = static_cast<int>(frac * width);
+    const double rate = elapsed > 0 ? static_cast<double>(done) / elapsed : 0.0;
+    std::fprintf(stderr, "\r[%s%s] %zu/%zu runs  %.1f runs/s  ", std::string(filled, '#').c_str(),
+                 std::string(width - filled, ' ').c_str(), done, total, rate);
+    if (done < total && rate > 0)
+      std::fprintf(stderr, "ETA %.0f s   ", static_cast<double>(total - done) / rate);
+    else if (done == total)
+      std::fprintf(stderr, "done in %.1f s\n", elapsed);
+    std::fflush(stderr);
+  }
+
+ private:
+  double last_ = -1.0;
+};
+
+void write_outputs(const std::string& dir, const MonteCarloResult& result, const nlohmann::json& summary) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw ConfigError("--out", dir, "cannot be created (" + ec.message() + ")");
+  const std::string csv = (std::filesystem::path(dir) / "runs.csv").string();
+  std::ofstream f(csv);
+  if (!f) throw ConfigError("--out", dir, "cannot write " + csv);
+  write_runs_csv(f, result.samples);
+  const std::string js = (std::filesystem::path(dir) / "summary.json").string();
+  std::ofstream g(js);
+  if (!g) throw ConfigError("--out", dir, "cannot write " + js);
+  g << summary.dump(2) << "\n";
+}
+
+int run_montecarlo(const MonteCarloArgs& a) {
+  YamlReader root = YamlReader::load_file(a.config);
+  SimulationSetup setup = read_simulation_setup(root);
+  MonteCarloConfig cfg = read_monte_carlo_config(root, std::move(setup));
+  root.finish();
+  apply_overrides(a, cfg);
+
+  const MonteCarloStudy& s = cfg.study;
+  auto sim = std::make_shared<const Simulator>(s.setup);  // validates the setup
+  const SampleFunction sample = [sim](const std::vector<double>& beta0, const RunOverrides& o) {
+    return sim->run(beta0, o);
+  };
+  const double end_time_s = sim->end_time_s();
+  ThreadPoolRunner runner(cfg.threads);
+
+  ProgressCallback progress;
+  if (isatty(fileno(stderr))) progress = ProgressBar{};
+  const MonteCarloResult result = run_monte_carlo(s, sample, runner, progress);
+  const MonteCarloStats stats = compute_statistics(result);
+
+  nlohmann::json summary = to_json(stats);
+  summary["study"] = study_json(a, cfg, end_time_s);
+  if (!a.out.empty()) write_outputs(a.out, result, summary);
+
+  if (a.json) {
+    std::cout << summary.dump(2) << "\n";
+  } else {
+    const InitialConditionDesign d = study_design(s);
+    std::cout << "Monte Carlo: " << a.config << "\n"
+              << "  design " << to_string(d.kind);
+    if (d.kind == InitialConditionKind::Grid)
+      std::cout << " " << d.grid_points_per_axis << "^" << d.balls;
+    std::cout << ", " << s.runs << " runs, seed " << s.seed << ", mu " << friction_text(s) << "\n"
+              << "  profile " << s.setup.profile.duration_s() << " s, end time " << end_time_s
+              << " s, imbalance without balls I = " << std::setprecision(4) << s.setup.abu.imbalance_kgm() * 1e7
+              << "e-7 kg m\n"
+              << std::setprecision(6) << format_summary(stats);
+    if (!a.out.empty()) std::cout << "wrote " << a.out << "/runs.csv and " << a.out << "/summary.json\n";
+  }
+  return stats.ok == 0 ? 3 : 0;
+}
+
+}  // namespace
+
+void register_montecarlo(CLI::App& app) {
+  auto args = std::make_shared<MonteCarloArgs>();
+  CLI::App* sub = app.add_subcommand(
+      "montecarlo",
+      "Monte Carlo over initial ball angles (and uncertain friction/imbalance) for one startup profile:\n"
+      "mean/median/max/quantiles of the residual imbalance (|I_r| and the report's I_r,x), %MI with its\n"
+      "95 % Wilson interval, %LC, settling time, peak amplitude, failed runs. Uses all cores; results do\n"
+      "not depend on the thread count. Options override the config's `montecarlo` section.\n"
+      "Exit status: 0 ok, 2 bad input, 3 every run failed.");
+  sub->add_option("config", args->config, "YAML config (sections abu, profile, motor, simulation, montecarlo)")
+      ->required();
+  sub->add_option("--runs", args->runs, "number of runs (grid design: must equal grid^balls)");
+  sub->add_option("--grid", args->grid, "grid design with this many points per axis (grid^balls runs)");
+  sub->add_option("--design", args->design, "initial-condition design: grid, random, lhs, halton, sobol");
+  sub->add_option("--seed", args->seed, "seed of the design and of the uncertain parameters");
+  sub->add_option("--threads", args->threads, "worker threads (0 = all cores)");
+  sub->add_option("--mu", args->mu, "fixed friction coefficient for every run (overrides montecarlo.friction)");
+  sub->add_flag("--json", args->json, "print one JSON object (summary and study) instead of the text summary");
+  sub->add_option("--out", args->out, "write runs.csv (one line per run) and summary.json into this directory");
+  sub->callback([args] { set_exit_code(run_montecarlo(*args)); });
+}
+
+}  // namespace abuopt::app
