@@ -23,6 +23,10 @@ class DriverTnlp : public Ipopt::TNLP {
   DriverTnlp(EvaluationDriver& d, const std::vector<double>& y0) : d_(d), y0_(y0) {}
 
   long iterations = 0;
+  // Ipopt may keep iterating on the same points when finite-difference noise keeps it above its
+  // tolerance; after kStallIterations iterations without a new evaluation it is stopped.
+  static constexpr int kStallIterations = 5;
+  bool stalled = false;
 
   bool get_nlp_info(Index& n, Index& m, Index& nnz_jac_g, Index& nnz_h_lag, IndexStyleEnum& index_style) override {
     n = static_cast<Index>(d_.n());
@@ -96,12 +100,23 @@ class DriverTnlp : public Ipopt::TNLP {
   bool intermediate_callback(Ipopt::AlgorithmMode, Index iter, Number, Number, Number, Number, Number, Number, Number,
                              Number, Index, const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
     iterations = iter;
+    if (d_.evaluations() == evaluations_at_last_iteration_) {
+      if (++iterations_without_new_points_ >= kStallIterations) {
+        stalled = true;
+        return false;
+      }
+    } else {
+      iterations_without_new_points_ = 0;
+    }
+    evaluations_at_last_iteration_ = d_.evaluations();
     return !d_.stopped();
   }
 
  private:
   EvaluationDriver& d_;
   std::vector<double> y0_;
+  long evaluations_at_last_iteration_ = -1;
+  int iterations_without_new_points_ = 0;
 };
 
 AdapterOutcome map_status(Ipopt::ApplicationReturnStatus s) {
@@ -159,6 +174,11 @@ AdapterOutcome run_ipopt(EvaluationDriver& d, const OptimizerOptions& options, c
   AdapterOutcome mapped = map_status(status);
   mapped.algorithm_label = out.algorithm_label;
   mapped.iterations = tnlp->iterations;
+  if (status == Ipopt::User_Requested_Stop && tnlp->stalled) {
+    mapped.reason = TerminationReason::converged_xtol;
+    mapped.message = "Ipopt stopped: no new point in " + std::to_string(DriverTnlp::kStallIterations) +
+                     " iterations (finite-difference noise above its tolerance)";
+  }
   return mapped;
 }
 
