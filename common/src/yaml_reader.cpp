@@ -74,13 +74,20 @@ YamlReader YamlReader::load_string(const std::string& text, const std::string& n
 
 std::string YamlReader::key_path(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
 
-bool YamlReader::has(const std::string& key) const { return present() && node_[key] && !node_[key].IsNull(); }
+bool YamlReader::has(const std::string& key) const {
+  if (!present()) return false;
+  const YAML::Node n = node_[key];
+  return n && !n.IsNull();
+}
 
 YAML::Node YamlReader::at(const std::string& key) {
   read_.insert(key);
-  if (!present()) return YAML::Node();
-  YAML::Node n = node_[key];
-  if (!n || n.IsNull()) return YAML::Node();
+  // An absent or null key gives an undefined node (operator! is true for it); a default-
+  // constructed YAML::Node would be a *defined* null.
+  if (!present()) return YAML::Node(YAML::NodeType::Undefined);
+  const YAML::Node& cnode = node_;  // const access: the non-const operator[] would insert the key
+  YAML::Node n = cnode[key];
+  if (!n || n.IsNull()) return YAML::Node(YAML::NodeType::Undefined);
   return n;
 }
 
@@ -179,7 +186,7 @@ std::vector<double> YamlReader::get_double_list(const std::string& key, const Ru
 
 YamlReader YamlReader::child(const std::string& key) { return YamlReader(at(key), key_path(key)); }
 
-bool YamlReader::is_sequence(const std::string& key) const { return has(key) && node_[key].IsSequence(); }
+bool YamlReader::is_sequence(const std::string& key) const { return has(key) && static_cast<const YAML::Node&>(node_)[key].IsSequence(); }
 
 std::vector<YamlReader> YamlReader::children(const std::string& key) {
   YAML::Node n = at(key);

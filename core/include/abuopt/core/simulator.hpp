@@ -19,13 +19,15 @@
 namespace abuopt {
 
 enum class FrictionMethod { EventDriven, SwitchModel };
-enum class IntegratorBackend { ArkodeErk, Cvode };
+// Native: our lean explicit RK stepper with ARKODE's Butcher tables (fast, the default).
+// ArkodeErk: SUNDIALS ARKODE ERKStep with its own root finding (the reference; ~20x slower here).
+enum class IntegratorBackend { Native, ArkodeErk };
 std::string to_string(FrictionMethod m);
 std::string to_string(IntegratorBackend b);
 
 struct SimulationOptions {
   FrictionMethod method = FrictionMethod::EventDriven;
-  IntegratorBackend backend = IntegratorBackend::ArkodeErk;
+  IntegratorBackend backend = IntegratorBackend::Native;
   std::string erk_table = "ARKODE_FEHLBERG_13_7_8";  // ARKODE built-in explicit table
   double rtol = 1e-6;
   double atol = 1e-9;              // on the non-dimensional state

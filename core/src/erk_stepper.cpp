@@ -1,0 +1,209 @@
+#include "erk_stepper.hpp"
+
+#include <arkode/arkode_butcher.h>
+#include <arkode/arkode_butcher_erk.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace abuopt::detail {
+
+ButcherTable ButcherTable::from_arkode(const std::string& name) {
+  ARKodeButcherTable B = ARKodeButcherTable_LoadERKByName(name.c_str());
+  if (!B) throw std::invalid_argument("unknown ARKODE explicit table '" + name + "'");
+  if (!B->d) {
+    ARKodeButcherTable_Free(B);
+    throw std::invalid_argument("ARKODE table '" + name + "' has no embedding (no error estimate)");
+  }
+  ButcherTable t;
+  t.stages = B->stages;
+  t.order = B->q;
+  t.embedded_order = B->p;
+  t.A.assign(static_cast<std::size_t>(t.stages * t.stages), 0.0);
+  for (int i = 0; i < t.stages; ++i)
+    for (int j = 0; j < t.stages; ++j) t.A[static_cast<std::size_t>(i * t.stages + j)] = B->A[i][j];
+  t.b.assign(B->b, B->b + t.stages);
+  t.c.assign(B->c, B->c + t.stages);
+  t.d.assign(B->d, B->d + t.stages);
+  ARKodeButcherTable_Free(B);
+  return t;
+}
+
+ErkStepper::ErkStepper(ButcherTable table, std::size_t n, RhsFn f, RootFn g, std::size_t nroots, void* user,
+                       double rtol, double atol, long max_steps)
+    : tab_(std::move(table)), n_(n), nroots_(nroots), f_(f), g_(g), user_(user), rtol_(rtol), atol_(atol),
+      max_steps_(max_steps) {
+  const std::size_t s = static_cast<std::size_t>(tab_.stages);
+  y_.resize(n);
+  f0_.resize(n);
+  yprev_.resize(n);
+  fprev_.resize(n);
+  ynew_.resize(n);
+  k_.resize(s * n);
+  tmp_.resize(n);
+  err_.resize(n);
+  g0_.resize(nroots);
+  g1_.resize(nroots);
+  gtmp_.resize(nroots);
+  found_.assign(nroots, 0);
+}
+
+void ErkStepper::reset(double t, const double* y) {
+  t_ = t;
+  std::copy(y, y + n_, y_.begin());
+  f_(t_, y_.data(), f0_.data(), user_);
+  ++nf_;
+  if (g_ && nroots_) g_(t_, y_.data(), g0_.data(), user_);
+  if (h_ <= 0) h_ = initial_step();
+  tprev_ = t_;
+  yprev_ = y_;
+  fprev_ = f0_;
+}
+
+double ErkStepper::initial_step() {
+  // Hairer-Norsett-Wanner's starting step heuristic (first-order part only).
+  double d0 = 0, d1 = 0;
+  for (std::size_t i = 0; i < n_; ++i) {
+    const double sc = atol_ + rtol_ * std::fabs(y_[i]);
+    d0 += (y_[i] / sc) * (y_[i] / sc);
+    d1 += (f0_[i] / sc) * (f0_[i] / sc);
+  }
+  d0 = std::sqrt(d0 / n_);
+  d1 = std::sqrt(d1 / n_);
+  double h = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
+  return std::min(h, 1.0);
+}
+
+double ErkStepper::attempt(double t0, const double* y0, const double* f0, double h, double* yout) {
+  const int s = tab_.stages;
+  std::copy(f0, f0 + n_, k_.begin());  // c_0 = 0 for every explicit table
+  for (int i = 1; i < s; ++i) {
+    for (std::size_t m = 0; m < n_; ++m) {
+      double acc = 0;
+      for (int j = 0; j < i; ++j) acc += tab_.A[static_cast<std::size_t>(i * s + j)] * k_[static_cast<std::size_t>(j) * n_ + m];
+      tmp_[m] = y0[m] + h * acc;
+    }
+    f_(t0 + tab_.c[static_cast<std::size_t>(i)] * h, tmp_.data(), &k_[static_cast<std::size_t>(i) * n_], user_);
+    ++nf_;
+  }
+  double norm = 0;
+  for (std::size_t m = 0; m < n_; ++m) {
+    double hi = 0, lo = 0;
+    for (int j = 0; j < s; ++j) {
+      const double kj = k_[static_cast<std::size_t>(j) * n_ + m];
+      hi += tab_.b[static_cast<std::size_t>(j)] * kj;
+      lo += tab_.d[static_cast<std::size_t>(j)] * kj;
+    }
+    yout[m] = y0[m] + h * hi;
+    const double e = h * (hi - lo);
+    const double sc = atol_ + rtol_ * std::max(std::fabs(y0[m]), std::fabs(yout[m]));
+    norm += (e / sc) * (e / sc);
+  }
+  return std::sqrt(norm / static_cast<double>(n_));
+}
+
+ErkStepper::Status ErkStepper::step() {
+  const int q = std::min(tab_.order, tab_.embedded_order);
+  const double expo = 1.0 / (q + 1);
+  if (t_ >= tstop_) return StopReached;
+  if (steps_ >= max_steps_) return TooManySteps;
+  for (;;) {
+    double h = std::min(h_, tstop_ - t_);
+    const bool to_stop = h >= tstop_ - t_;
+    if (h < 1e-14 * std::max(1.0, std::fabs(t_))) return StepTooSmall;
+    const double err = attempt(t_, y_.data(), f0_.data(), h, ynew_.data());
+    const double fac = err > 0 ? 0.9 * std::pow(err, -expo) : 5.0;
+    if (err <= 1.0 && std::isfinite(err)) {
+      // accept
+      tprev_ = t_;
+      yprev_.swap(y_);
+      fprev_.swap(f0_);
+      t_ = to_stop ? tstop_ : t_ + h;
+      y_.swap(ynew_);
+      f_(t_, y_.data(), f0_.data(), user_);
+      ++nf_;
+      ++steps_;
+      if (!to_stop || h == h_) h_ = h * std::clamp(fac, 0.2, 5.0);
+      break;
+    }
+    h_ = h * std::clamp(std::isfinite(fac) ? fac : 0.1, 0.1, 0.9);
+  }
+  if (!g_ || nroots_ == 0) return t_ >= tstop_ ? StopReached : Ok;
+
+  // Root detection over [tprev, t].
+  g_(t_, y_.data(), g1_.data(), user_);
+  double troot = t_ + 1.0;
+  int first = -1;
+  for (std::size_t k = 0; k < nroots_; ++k) {
+    const double a = g0_[k], b = g1_[k];
+    if (a == 0.0 || !((a < 0) != (b < 0) || b == 0.0)) continue;
+    // Illinois on the Hermite interpolant.
+    double ta = tprev_, tb = t_, ga = a, gb = b;
+    int side = 0;
+    for (int it = 0; it < 60 && std::fabs(tb - ta) > 1e-14 * std::max(1.0, std::fabs(t_)); ++it) {
+      const double tc = (gb != ga) ? tb - gb * (tb - ta) / (gb - ga) : 0.5 * (ta + tb);
+      dense(tc, tmp_.data());
+      g_(tc, tmp_.data(), gtmp_.data(), user_);
+      const double gc = gtmp_[k];
+      if (gc == 0.0) {
+        ta = tb = tc;
+        break;
+      }
+      if ((gc < 0) == (gb < 0)) {
+        tb = tc;
+        gb = gc;
+        if (side == -1) ga *= 0.5;
+        side = -1;
+      } else {
+        ta = tc;
+        ga = gc;
+        if (side == 1) gb *= 0.5;
+        side = 1;
+      }
+    }
+    const double tk = tb;  // on the far side of the crossing
+    if (tk < troot) {
+      troot = tk;
+      first = static_cast<int>(k);
+    }
+  }
+  if (first < 0) {
+    g0_.swap(g1_);
+    return t_ >= tstop_ ? StopReached : Ok;
+  }
+  // Recompute the state at the root with a fresh RK step from the step's start.
+  const double hroot = troot - tprev_;
+  if (hroot > 0) {
+    attempt(tprev_, yprev_.data(), fprev_.data(), hroot, ynew_.data());
+    y_ = ynew_;
+  } else {
+    y_ = yprev_;
+  }
+  t_ = troot;
+  f_(t_, y_.data(), f0_.data(), user_);  // keeps dense() consistent on [tprev, troot]
+  ++nf_;
+  g_(t_, y_.data(), g1_.data(), user_);
+  std::fill(found_.begin(), found_.end(), 0);
+  found_[static_cast<std::size_t>(first)] = 1;
+  for (std::size_t k = 0; k < nroots_; ++k) {
+    const double a = g0_[k], b = g1_[k];
+    if (a != 0.0 && ((a < 0) != (b < 0) || b == 0.0)) found_[k] = 1;
+  }
+  return Root;  // the caller resets the stepper at the root
+}
+
+void ErkStepper::dense(double t, double* out) const {
+  const double h = t_ - tprev_;
+  if (h <= 0) {
+    std::copy(y_.begin(), y_.end(), out);
+    return;
+  }
+  const double th = (t - tprev_) / h;
+  const double h00 = (1 + 2 * th) * (1 - th) * (1 - th), h10 = th * (1 - th) * (1 - th);
+  const double h01 = th * th * (3 - 2 * th), h11 = th * th * (th - 1);
+  for (std::size_t m = 0; m < n_; ++m)
+    out[m] = h00 * yprev_[m] + h10 * h * fprev_[m] + h01 * y_[m] + h11 * h * f0_[m];
+}
+
+}  // namespace abuopt::detail

@@ -1,0 +1,89 @@
+#include "abuopt/core/profile.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "abuopt/common/config_error.hpp"
+
+namespace abuopt {
+
+namespace {
+constexpr double kTwoPi = 2.0 * M_PI;
+
+// phi - sin(phi), accurate for small phi (the naive difference loses all digits as phi -> 0).
+double phi_minus_sin(double phi) {
+  if (std::fabs(phi) < 0.5) {
+    // phi^3/6 - phi^5/120 + phi^7/5040 - phi^9/362880 + phi^11/39916800 (error < 1e-16 rel)
+    const double p2 = phi * phi;
+    return phi * p2 * (1.0 / 6 - p2 * (1.0 / 120 - p2 * (1.0 / 5040 - p2 * (1.0 / 362880 - p2 / 39916800.0))));
+  }
+  return phi - std::sin(phi);
+}
+}  // namespace
+
+StartupProfile::StartupProfile(std::vector<InclinedSineSegment> segments, double start_frequency_hz)
+    : segments_(std::move(segments)), start_hz_(start_frequency_hz) {
+  breaks_.assign(1, 0.0);
+  double t = 0;
+  for (const auto& s : segments_) {
+    t += s.duration_s;
+    breaks_.push_back(t);
+  }
+  duration_s_ = t;
+}
+
+StartupProfile StartupProfile::report_final() {
+  return StartupProfile({{25.0, 1.0}, {29.5, 10.0}, {100.0, 8.0}}, 0.0);
+}
+
+double StartupProfile::final_frequency_hz() const {
+  return segments_.empty() ? start_hz_ : segments_.back().end_frequency_hz;
+}
+
+ProfileSample StartupProfile::sample(double t) const {
+  ProfileSample s;
+  if (segments_.empty() || t <= 0) {
+    s.frequency_hz = start_hz_;
+    return s;
+  }
+  if (t >= duration_s_) {
+    s.frequency_hz = final_frequency_hz();
+    return s;
+  }
+  // Segment index: last breakpoint <= t.
+  const auto it = std::upper_bound(breaks_.begin(), breaks_.end(), t);
+  const std::size_t k = static_cast<std::size_t>(it - breaks_.begin()) - 1;
+  const double t0 = breaks_[k];
+  const double f0 = k == 0 ? start_hz_ : segments_[k - 1].end_frequency_hz;
+  const double H = segments_[k].end_frequency_hz - f0;
+  const double dt = segments_[k].duration_s;
+  const double phi = kTwoPi * (t - t0) / dt;
+  const double sh = std::sin(0.5 * phi);
+  s.frequency_hz = f0 + H / kTwoPi * phi_minus_sin(phi);
+  s.rate_hz_per_s = 2.0 * H / dt * sh * sh;  // H/dt (1 - cos phi), without cancellation
+  s.accel_hz_per_s2 = kTwoPi * H / (dt * dt) * std::sin(phi);
+  return s;
+}
+
+void validate(const StartupProfile& p, const char* path_c) {
+  const std::string path(path_c);
+  auto num = [](double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
+  };
+  if (!std::isfinite(p.start_frequency_hz()) || p.start_frequency_hz() < 0)
+    throw ConfigError(path + ".start_frequency_hz", num(p.start_frequency_hz()), "must be >= 0");
+  for (std::size_t i = 0; i < p.segments().size(); ++i) {
+    const auto& s = p.segments()[i];
+    const std::string sp = path + ".segments[" + std::to_string(i) + "]";
+    if (!(std::isfinite(s.duration_s) && s.duration_s > 0))
+      throw ConfigError(sp + ".duration_s", num(s.duration_s), "must be > 0");
+    if (!(std::isfinite(s.end_frequency_hz) && s.end_frequency_hz >= 0))
+      throw ConfigError(sp + ".end_frequency_hz", num(s.end_frequency_hz), "must be >= 0");
+  }
+}
+
+}  // namespace abuopt
