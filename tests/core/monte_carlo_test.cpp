@@ -209,6 +209,42 @@ TEST(MonteCarlo, InvalidStudiesAreConfigErrors) {
   EXPECT_THROW(validate(s), ConfigError);
 }
 
+// --- end to end with the real simulator ------------------------------------------------------
+
+// A handful of runs of the report's final profile through Simulator::run (well under a second): the
+// engine's guarantees hold with the real model, and the outcomes are physically plausible.
+TEST(MonteCarloSimulator, FewRunsOfTheFinalProfileAreThreadCountIndependent) {
+  MonteCarloStudy s;  // default setup: report table 3.2, mu 0.02, the report's final profile
+  s.design.kind = InitialConditionKind::Halton;
+  s.design.seed = 5;
+  s.runs = 12;
+  ThreadPoolRunner one(1), three(3);
+  const MonteCarloResult r1 = run_monte_carlo(s, one);
+  const MonteCarloResult r3 = run_monte_carlo(s, three);
+  EXPECT_EQ(csv_of(r1), csv_of(r3));
+  const MonteCarloSample replay = run_one(s, 4);
+  EXPECT_EQ(replay.outcome.residual_imbalance_kgm, r1.samples[4].outcome.residual_imbalance_kgm);
+  EXPECT_EQ(replay.outcome.beta_final, r1.samples[4].outcome.beta_final);
+
+  const AbuParameters& p = s.setup.abu;
+  // |I_r| <= m_I e + sum m_i L; I_r,x <= |I_r|
+  const double bound = p.imbalance_kgm() + 2 * p.balls[0].mass_kg * p.ball_track_radius_m;
+  std::size_t ok = 0;
+  for (const auto& smp : r1.samples) {
+    if (!smp.outcome.ok()) continue;
+    ++ok;
+    EXPECT_EQ(smp.outcome.beta_final.size(), 2u);
+    EXPECT_GE(smp.outcome.residual_imbalance_x_kgm, 0.0);
+    EXPECT_LE(smp.outcome.residual_imbalance_x_kgm, smp.outcome.residual_imbalance_kgm * (1 + 1e-12));
+    EXPECT_LE(smp.outcome.residual_imbalance_kgm, bound * (1 + 1e-12));
+    EXPECT_GT(smp.outcome.max_amplitude_mm, 0.0);
+  }
+  EXPECT_GE(ok, 10u);
+  const MonteCarloStats st = compute_statistics(r1);
+  EXPECT_EQ(st.ok, ok);
+  EXPECT_DOUBLE_EQ(s.setup.abu.imbalance_kgm(), r1.samples[0].imbalance_kgm);
+}
+
 // --- configuration ----------------------------------------------------------------------------
 
 MonteCarloConfig read(const std::string& yaml) {
