@@ -9,7 +9,9 @@
 //  - task(i) is called exactly once for every i in [0, count) (unless a task throws);
 //  - tasks may run concurrently, so task must be safe to call from several threads at once;
 //  - the progress callback (if set) is called with (done, total, elapsed_s), done increasing,
-//    never concurrently with itself, and a last time with done == total;
+//    never concurrently with itself, and a last time with done == total; it runs on a worker
+//    thread while the other workers wait for it, so keep it cheap (throttle any drawing); it may
+//    throw to cancel the batch (handled like a throwing task);
 //  - if a task throws, the remaining tasks are skipped (those running finish) and the first
 //    exception is rethrown from run() after all workers have stopped.
 #include <cstddef>
