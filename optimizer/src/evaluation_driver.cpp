@@ -110,9 +110,26 @@ const EvaluatedPoint* EvaluationDriver::evaluate(const double* y, bool for_gradi
     p.e.objective = kInf;
     if (p.e.message.empty()) p.e.message = "objective is NaN";
   }
+  auto has_nan = [](const std::vector<double>& v) {
+    for (double d : v)
+      if (std::isnan(d)) return true;
+    return false;
+  };
+  if (p.e.ok && (has_nan(p.e.inequality) || has_nan(p.e.equality))) {
+    p.e.ok = false;
+    p.e.objective = kInf;
+    if (p.e.message.empty()) p.e.message = "a constraint value is NaN";
+  }
   p.violation = max_constraint_violation(p.e);
   p.feasible = is_feasible(p.e, options_.constraint_tolerance);
 
+  if (p.e.ok) {
+    if (std::isfinite(p.e.objective)) max_finite_objective_ = std::max(max_finite_objective_, p.e.objective);
+    for (double g : p.e.inequality)
+      if (std::isfinite(g)) max_abs_constraint_ = std::max(max_abs_constraint_, std::fabs(g));
+    for (double h : p.e.equality)
+      if (std::isfinite(h)) max_abs_constraint_ = std::max(max_abs_constraint_, std::fabs(h));
+  }
   ++evaluations_;
   if (p.e.from_archive) ++archive_hits_;
   if (!p.e.ok) ++failed_;
@@ -170,6 +187,13 @@ const EvaluatedPoint* EvaluationDriver::evaluate(const double* y, bool for_gradi
   if (options_.keep_history) history_.push_back(std::move(rec));
   return &stored;
 }
+
+double EvaluationDriver::failure_objective() const {
+  if (!std::isfinite(max_finite_objective_)) return 1e10;
+  return max_finite_objective_ + std::fabs(max_finite_objective_) + 1.0;
+}
+
+double EvaluationDriver::failure_constraint() const { return max_abs_constraint_ + 1.0; }
 
 bool EvaluationDriver::derivatives(const double* y_in, const EvaluatedPoint& base, double* grad_f, double* jac_ineq,
                                    double* jac_eq) {

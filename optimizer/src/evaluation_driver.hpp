@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <deque>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -50,6 +51,13 @@ class EvaluationDriver {
   void stop(TerminationReason reason, std::string message);
 
   long evaluations() const { return evaluations_; }
+
+  // What an optimiser is told for a failed evaluation (the result and history keep +inf):
+  // model-based methods (COBYLA, BOBYQA, ...) break on inf, so they get a finite penalty,
+  // the largest finite objective seen so far plus its magnitude plus 1 (1e10 before any), and
+  // for each constraint the largest |constraint value| seen so far plus 1 (violated).
+  double failure_objective() const;
+  double failure_constraint() const;
   double elapsed_s() const;
 
   // Fills the counts, best point and history of `r` (reason and message are the caller's).
@@ -72,6 +80,8 @@ class EvaluationDriver {
   std::optional<std::size_t> best_;
   std::vector<EvaluationRecord> history_;
 
+  double max_finite_objective_ = -std::numeric_limits<double>::infinity();
+  double max_abs_constraint_ = 0.0;
   long evaluations_ = 0, archive_hits_ = 0, failed_ = 0, gradient_evals_ = 0, repeats_ = 0, clipped_ = 0;
   std::optional<TerminationReason> stop_reason_;
   std::string stop_message_;

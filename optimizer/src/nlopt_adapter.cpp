@@ -59,7 +59,7 @@ double objective(unsigned n, const double* y, double* grad, void* data) {
   }
   if (grad && !c.driver->derivatives(y, *p, grad, nullptr, nullptr)) std::fill(grad, grad + n, 0.0);
   stop_if_needed(c);
-  return p->e.ok ? p->e.objective : HUGE_VAL;
+  return p->e.ok ? p->e.objective : c.driver->failure_objective();
 }
 
 template <bool Equality>
@@ -67,7 +67,7 @@ void constraints(unsigned m, double* result, unsigned n, const double* y, double
   Context& c = *static_cast<Context*>(data);
   const EvaluatedPoint* p = c.driver->evaluate(y);
   if (!p || !p->e.ok) {
-    std::fill(result, result + m, HUGE_VAL);
+    std::fill(result, result + m, p ? c.driver->failure_constraint() : HUGE_VAL);
     if (grad) std::fill(grad, grad + static_cast<std::size_t>(m) * n, 0.0);
     if (!p) nlopt_force_stop(c.outer);
     return;
@@ -84,6 +84,8 @@ void constraints(unsigned m, double* result, unsigned n, const double* y, double
 
 void set_tolerances(nlopt_opt o, const OptimizerOptions& options, const EvaluationDriver& d) {
   nlopt_set_xtol_rel(o, options.xtol_rel);
+  // An absolute floor in scaled units, so that a variable converging to 0 can meet the test.
+  nlopt_set_xtol_abs1(o, 0.01 * options.xtol_rel);
   nlopt_set_ftol_rel(o, options.ftol_rel);
   nlopt_set_ftol_abs(o, options.ftol_abs);
   if (options.initial_step > 0) {

@@ -32,7 +32,8 @@ struct OptimizerOptions {
   // Iteration limit for Ipopt (max_iter); 0: Ipopt's default (3000). NLopt has no iterations.
   long max_iterations = 0;
 
-  // Stop when a step changes every x_i by less than xtol_rel * |x_i| (scaled x); 0: off.
+  // Stop when a step changes every x_i by less than xtol_rel * |x_i| (NLopt: on x / scale, with
+  // an absolute floor of 0.01 * xtol_rel so that a variable converging to 0 can stop); 0: off.
   double xtol_rel = 1e-6;
   // Stop when a step changes f by less than ftol_rel * |f|; 0: off. Ipopt: its `tol`.
   double ftol_rel = 1e-8;

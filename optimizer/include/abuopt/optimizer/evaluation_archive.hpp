@@ -1,0 +1,101 @@
+#pragma once
+// EvaluationArchive: every evaluation of a study stored in an SQLite file (the idea of OpenMDAO's
+// SqliteRecorder), so that a study never evaluates the same design twice and a killed study
+// resumes where it stopped.
+//
+// * Problem identity: a string given by the caller (e.g. a hash of the resolved config). One file
+//   may hold several problems; lookups only ever match the same problem id.
+// * Exact matching: the design vector is stored as the hex of each double's bits (plus a readable
+//   JSON copy), so find(x) answers only a bitwise-identical repeat. Objective and constraint
+//   values are stored the same way and come back bit for bit; metrics are JSON (doubles
+//   round-trip exactly; inf/nan are stored as the strings "inf", "-inf", "nan").
+// * Durability: WAL journal, each store() is its own committed transaction. Killing the process
+//   (even SIGKILL) loses nothing that store() returned from (synchronous=NORMAL: an OS crash or
+//   power loss may lose the last few commits).
+// * Thread-safe: every method takes a mutex.
+//
+// ArchivedProblem decorates any Problem: evaluate(x) first asks the archive; a hit is returned
+// with Evaluation::from_archive = true (and counted by minimize() in archive_hits), a miss is
+// evaluated by the wrapped problem and stored. Failed evaluations (ok == false) are stored too
+// (a rerun would fail the same way); evaluations that throw are not stored.
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "abuopt/optimizer/problem.hpp"
+
+struct sqlite3;
+
+namespace abuopt::opt {
+
+class EvaluationArchive {
+ public:
+  struct Entry {
+    long id = 0;
+    std::vector<double> x;
+    Evaluation evaluation;
+    double wall_time_s = 0.0;
+    std::string timestamp;  // ISO 8601, UTC
+  };
+
+  // Opens or creates the archive file; throws abuopt::ConfigError naming the file if it cannot.
+  EvaluationArchive(const std::string& path, std::string problem_id);
+  ~EvaluationArchive();
+  EvaluationArchive(const EvaluationArchive&) = delete;
+  EvaluationArchive& operator=(const EvaluationArchive&) = delete;
+
+  const std::string& path() const { return path_; }
+  const std::string& problem_id() const { return problem_id_; }
+
+  // The stored evaluation of exactly x (bitwise) for this problem id, if any.
+  std::optional<Evaluation> find(const std::vector<double>& x) const;
+  // Stores one evaluation and commits. A repeat of an x already stored is ignored (first wins).
+  void store(const std::vector<double>& x, const Evaluation& evaluation, double wall_time_s);
+  // Number of evaluations stored for this problem id.
+  long count() const;
+  // All evaluations of this problem id, in the order they were stored.
+  std::vector<Entry> entries() const;
+
+  // Records the problem's variable and constraint names under this problem id, or, if already
+  // recorded, throws abuopt::ConfigError when they differ (an id reused for another problem).
+  void check_signature(const Problem& problem);
+
+  // The exact key of a design vector: 16 hex digits per double, of its IEEE-754 bits.
+  static std::string key_of(const std::vector<double>& x);
+
+ private:
+  void exec(const char* sql) const;
+  std::string path_;
+  std::string problem_id_;
+  sqlite3* db_ = nullptr;
+  mutable std::mutex mutex_;
+};
+
+class ArchivedProblem : public Problem {
+ public:
+  // Both must outlive this object. Calls archive.check_signature(inner).
+  ArchivedProblem(Problem& inner, EvaluationArchive& archive);
+
+  std::string name() const override { return inner_.name(); }
+  std::vector<Variable> variables() const override { return inner_.variables(); }
+  std::vector<std::string> inequality_names() const override { return inner_.inequality_names(); }
+  std::vector<std::string> equality_names() const override { return inner_.equality_names(); }
+  std::vector<double> initial_point() const override { return inner_.initial_point(); }
+  std::optional<BestKnown> best_known() const override { return inner_.best_known(); }
+
+  Evaluation evaluate(const std::vector<double>& x) override;
+
+  long hits() const { return hits_.load(); }      // answered from the archive
+  long misses() const { return misses_.load(); }  // evaluated by the wrapped problem and stored
+
+ private:
+  Problem& inner_;
+  EvaluationArchive& archive_;
+  std::atomic<long> hits_{0};
+  std::atomic<long> misses_{0};
+};
+
+}  // namespace abuopt::opt

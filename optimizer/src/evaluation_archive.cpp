@@ -1,0 +1,307 @@
+#include "abuopt/optimizer/evaluation_archive.hpp"
+
+#include <sqlite3.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <ctime>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+#include "abuopt/common/config_error.hpp"
+
+namespace abuopt::opt {
+
+namespace {
+
+using json = nlohmann::json;
+
+std::string hex_of(const std::vector<double>& v) {
+  static const char* digits = "0123456789abcdef";
+  std::string s;
+  s.reserve(16 * v.size());
+  for (double d : v) {
+    std::uint64_t bits;
+    std::memcpy(&bits, &d, sizeof bits);
+    for (int shift = 60; shift >= 0; shift -= 4) s.push_back(digits[(bits >> shift) & 0xf]);
+  }
+  return s;
+}
+
+std::vector<double> doubles_of_hex(const std::string& s) {
+  if (s.size() % 16 != 0) throw std::runtime_error("evaluation archive: corrupt hex field");
+  std::vector<double> v(s.size() / 16);
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    std::uint64_t bits = std::stoull(s.substr(16 * i, 16), nullptr, 16);
+    std::memcpy(&v[i], &bits, sizeof bits);
+  }
+  return v;
+}
+
+json number_json(double v) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  return v;
+}
+
+double json_number(const json& j) {
+  if (j.is_number()) return j.get<double>();
+  if (j.is_string()) {
+    const std::string s = j.get<std::string>();
+    if (s == "inf") return INFINITY;
+    if (s == "-inf") return -INFINITY;
+  }
+  return NAN;
+}
+
+json vector_json(const std::vector<double>& v) {
+  json a = json::array();
+  for (double d : v) a.push_back(number_json(d));
+  return a;
+}
+
+std::string now_utc() {
+  const auto now = std::chrono::system_clock::now();
+  const std::time_t t = std::chrono::system_clock::to_time_t(now);
+  const long ms =
+      static_cast<long>(std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[40];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%S", &tm);
+  char out[48];
+  std::snprintf(out, sizeof out, "%s.%03ldZ", buf, ms);
+  return out;
+}
+
+// RAII prepared statement.
+class Statement {
+ public:
+  Statement(sqlite3* db, const char* sql) : db_(db) {
+    if (sqlite3_prepare_v2(db, sql, -1, &stmt_, nullptr) != SQLITE_OK)
+      throw std::runtime_error(std::string("evaluation archive: ") + sqlite3_errmsg(db));
+  }
+  ~Statement() { sqlite3_finalize(stmt_); }
+  Statement(const Statement&) = delete;
+  Statement& operator=(const Statement&) = delete;
+  void bind(int i, const std::string& s) { sqlite3_bind_text(stmt_, i, s.c_str(), -1, SQLITE_TRANSIENT); }
+  void bind(int i, double d) {
+    if (std::isnan(d)) sqlite3_bind_null(stmt_, i);
+    else sqlite3_bind_double(stmt_, i, d);
+  }
+  void bind_int(int i, long v) { sqlite3_bind_int64(stmt_, i, v); }
+  bool step() {
+    const int rc = sqlite3_step(stmt_);
+    if (rc == SQLITE_ROW) return true;
+    if (rc == SQLITE_DONE) return false;
+    throw std::runtime_error(std::string("evaluation archive: ") + sqlite3_errmsg(db_));
+  }
+  std::string text(int col) const {
+    const unsigned char* t = sqlite3_column_text(stmt_, col);
+    return t ? reinterpret_cast<const char*>(t) : "";
+  }
+  double real(int col) const { return sqlite3_column_double(stmt_, col); }
+  long integer(int col) const { return static_cast<long>(sqlite3_column_int64(stmt_, col)); }
+
+ private:
+  sqlite3* db_;
+  sqlite3_stmt* stmt_ = nullptr;
+};
+
+// Columns: values_hex, ok, message, metrics, n_inequality
+Evaluation evaluation_of(const Statement& s, int first) {
+  Evaluation e;
+  const std::vector<double> values = doubles_of_hex(s.text(first));
+  e.ok = s.integer(first + 1) != 0;
+  e.message = s.text(first + 2);
+  const json metrics = json::parse(s.text(first + 3));
+  for (auto it = metrics.begin(); it != metrics.end(); ++it) e.metrics[it.key()] = json_number(it.value());
+  const std::size_t n_ineq = static_cast<std::size_t>(s.integer(first + 4));
+  if (values.empty() || values.size() < 1 + n_ineq) throw std::runtime_error("evaluation archive: corrupt values");
+  e.objective = values[0];
+  e.inequality.assign(values.begin() + 1, values.begin() + 1 + static_cast<long>(n_ineq));
+  e.equality.assign(values.begin() + 1 + static_cast<long>(n_ineq), values.end());
+  return e;
+}
+
+}  // namespace
+
+std::string EvaluationArchive::key_of(const std::vector<double>& x) { return hex_of(x); }
+
+EvaluationArchive::EvaluationArchive(const std::string& path, std::string problem_id)
+    : path_(path), problem_id_(std::move(problem_id)) {
+  if (sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,
+                      nullptr) != SQLITE_OK) {
+    const std::string why = db_ ? sqlite3_errmsg(db_) : "out of memory";
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw ConfigError("evaluation archive '" + path + "' cannot be opened: " + why);
+  }
+  sqlite3_busy_timeout(db_, 10000);
+  try {
+    exec("PRAGMA journal_mode=WAL");
+    exec("PRAGMA synchronous=NORMAL");
+    exec(
+        "CREATE TABLE IF NOT EXISTS evaluations ("
+        " id INTEGER PRIMARY KEY AUTOINCREMENT,"
+        " problem_id TEXT NOT NULL,"
+        " x_key TEXT NOT NULL,"        // hex of the bits of x (exact)
+        " x TEXT NOT NULL,"            // JSON array (readable)
+        " objective REAL,"             // readable; NULL for NaN
+        " values_hex TEXT NOT NULL,"   // hex of objective, g..., h... (exact)
+        " n_inequality INTEGER NOT NULL,"
+        " inequality TEXT NOT NULL,"   // JSON (readable)
+        " equality TEXT NOT NULL,"     // JSON (readable)
+        " metrics TEXT NOT NULL,"      // JSON object
+        " ok INTEGER NOT NULL,"
+        " message TEXT NOT NULL,"
+        " wall_time_s REAL,"
+        " timestamp TEXT NOT NULL,"
+        " UNIQUE(problem_id, x_key))");
+    exec(
+        "CREATE TABLE IF NOT EXISTS problems ("
+        " problem_id TEXT PRIMARY KEY, name TEXT, variables TEXT, inequality TEXT, equality TEXT,"
+        " created TEXT)");
+  } catch (const std::exception& e) {
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw ConfigError("evaluation archive '" + path + "' is not usable: " + e.what());
+  }
+}
+
+EvaluationArchive::~EvaluationArchive() {
+  if (db_) sqlite3_close(db_);
+}
+
+void EvaluationArchive::exec(const char* sql) const {
+  char* err = nullptr;
+  if (sqlite3_exec(db_, sql, nullptr, nullptr, &err) != SQLITE_OK) {
+    const std::string why = err ? err : "unknown error";
+    sqlite3_free(err);
+    throw std::runtime_error("evaluation archive: " + why);
+  }
+}
+
+std::optional<Evaluation> EvaluationArchive::find(const std::vector<double>& x) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Statement s(db_,
+              "SELECT values_hex, ok, message, metrics, n_inequality FROM evaluations"
+              " WHERE problem_id = ?1 AND x_key = ?2");
+  s.bind(1, problem_id_);
+  s.bind(2, hex_of(x));
+  if (!s.step()) return std::nullopt;
+  Evaluation e = evaluation_of(s, 0);
+  e.from_archive = true;
+  return e;
+}
+
+void EvaluationArchive::store(const std::vector<double>& x, const Evaluation& e, double wall_time_s) {
+  std::vector<double> values{e.objective};
+  values.insert(values.end(), e.inequality.begin(), e.inequality.end());
+  values.insert(values.end(), e.equality.begin(), e.equality.end());
+  json metrics = json::object();
+  for (const auto& [k, v] : e.metrics) metrics[k] = number_json(v);
+  std::lock_guard<std::mutex> lock(mutex_);
+  Statement s(db_,
+              "INSERT OR IGNORE INTO evaluations (problem_id, x_key, x, objective, values_hex, n_inequality,"
+              " inequality, equality, metrics, ok, message, wall_time_s, timestamp)"
+              " VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13)");
+  s.bind(1, problem_id_);
+  s.bind(2, hex_of(x));
+  s.bind(3, vector_json(x).dump());
+  s.bind(4, e.objective);
+  s.bind(5, hex_of(values));
+  s.bind_int(6, static_cast<long>(e.inequality.size()));
+  s.bind(7, vector_json(e.inequality).dump());
+  s.bind(8, vector_json(e.equality).dump());
+  s.bind(9, metrics.dump());
+  s.bind_int(10, e.ok ? 1 : 0);
+  s.bind(11, e.message);
+  s.bind(12, wall_time_s);
+  s.bind(13, now_utc());
+  s.step();  // autocommit: one transaction per store
+}
+
+long EvaluationArchive::count() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Statement s(db_, "SELECT COUNT(*) FROM evaluations WHERE problem_id = ?1");
+  s.bind(1, problem_id_);
+  s.step();
+  return s.integer(0);
+}
+
+std::vector<EvaluationArchive::Entry> EvaluationArchive::entries() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Statement s(db_,
+              "SELECT id, x_key, wall_time_s, timestamp, values_hex, ok, message, metrics, n_inequality"
+              " FROM evaluations WHERE problem_id = ?1 ORDER BY id");
+  s.bind(1, problem_id_);
+  std::vector<Entry> out;
+  while (s.step()) {
+    Entry en;
+    en.id = s.integer(0);
+    en.x = doubles_of_hex(s.text(1));
+    en.wall_time_s = s.real(2);
+    en.timestamp = s.text(3);
+    en.evaluation = evaluation_of(s, 4);
+    en.evaluation.from_archive = true;
+    out.push_back(std::move(en));
+  }
+  return out;
+}
+
+void EvaluationArchive::check_signature(const Problem& problem) {
+  json vars = json::array();
+  for (const Variable& v : problem.variables()) vars.push_back(v.name);
+  const std::string variables = vars.dump();
+  const std::string ineq = json(problem.inequality_names()).dump();
+  const std::string eq = json(problem.equality_names()).dump();
+  std::lock_guard<std::mutex> lock(mutex_);
+  Statement q(db_, "SELECT variables, inequality, equality FROM problems WHERE problem_id = ?1");
+  q.bind(1, problem_id_);
+  if (q.step()) {
+    auto differ = [&](const char* what, const std::string& stored, const std::string& now) {
+      if (stored != now)
+        throw ConfigError("evaluation archive '" + path_ + "': problem id '" + problem_id_ + "' was recorded with " +
+                          what + " " + stored + ", this problem has " + now +
+                          " (use another problem id for a different problem)");
+    };
+    differ("variables", q.text(0), variables);
+    differ("inequality constraints", q.text(1), ineq);
+    differ("equality constraints", q.text(2), eq);
+    return;
+  }
+  Statement s(db_,
+              "INSERT INTO problems (problem_id, name, variables, inequality, equality, created)"
+              " VALUES (?1, ?2, ?3, ?4, ?5, ?6)");
+  s.bind(1, problem_id_);
+  s.bind(2, problem.name());
+  s.bind(3, variables);
+  s.bind(4, ineq);
+  s.bind(5, eq);
+  s.bind(6, now_utc());
+  s.step();
+}
+
+ArchivedProblem::ArchivedProblem(Problem& inner, EvaluationArchive& archive) : inner_(inner), archive_(archive) {
+  archive_.check_signature(inner_);
+}
+
+Evaluation ArchivedProblem::evaluate(const std::vector<double>& x) {
+  if (std::optional<Evaluation> hit = archive_.find(x)) {
+    ++hits_;
+    return *hit;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  Evaluation e = inner_.evaluate(x);  // an exception propagates and nothing is stored
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  e.from_archive = false;
+  archive_.store(x, e, wall);
+  ++misses_;
+  return e;
+}
+
+}  // namespace abuopt::opt

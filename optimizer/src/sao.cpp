@@ -1,0 +1,843 @@
+// SAO: sequential approximate optimisation in a trust region (see sao.hpp for the algorithm).
+#include "abuopt/optimizer/sao.hpp"
+
+#include <nlopt.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <csignal>
+#include <limits>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <sstream>
+#include <type_traits>
+
+#include <Eigen/Dense>
+
+#include "abuopt/common/config_error.hpp"
+#include "abuopt/surrogate/doe.hpp"
+#include "abuopt/surrogate/kriging.hpp"
+#include "abuopt/surrogate/response_surface.hpp"
+#include "abuopt/surrogate/surrogate.hpp"
+#include "evaluation_driver.hpp"
+
+namespace abuopt::opt {
+
+// ---------------------------------------------------------------------------------------------
+// Options
+
+namespace {
+
+const std::vector<std::string>& surrogate_choices() {
+  static const std::vector<std::string> c = {"auto", "linear", "interactions", "pure_quadratic", "quadratic",
+                                             "kriging"};
+  return c;
+}
+const std::vector<std::string>& doe_choices() {
+  static const std::vector<std::string> c = {"auto", "koshal", "axial", "central_composite", "lhs"};
+  return c;
+}
+const std::vector<std::string>& solver_choices() {
+  static const std::vector<std::string> c = {"slsqp", "cobyla"};
+  return c;
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+  return s;
+}
+
+void require(bool ok, const std::string& prefix, const std::string& key, double value, const std::string& rule) {
+  if (!ok) throw ConfigError(prefix + "." + key, format_number(value), rule);
+}
+void require_choice(const std::string& prefix, const std::string& key, const std::string& value,
+                    const std::vector<std::string>& choices) {
+  if (std::find(choices.begin(), choices.end(), value) == choices.end())
+    throw ConfigError(prefix + "." + key, value.empty() ? "\"\"" : value, "must be one of: " + join(choices));
+}
+
+}  // namespace
+
+void SaoOptions::validate(const std::string& p) const {
+  require_choice(p, "surrogate", surrogate, surrogate_choices());
+  require_choice(p, "doe", doe, doe_choices());
+  require_choice(p, "subproblem_solver", subproblem_solver, solver_choices());
+  require(doe_points >= 0, p, "doe_points", doe_points, "must be >= 0 (0: automatic)");
+  require(std::isfinite(reuse_distance) && reuse_distance > 0 && reuse_distance <= 1, p, "reuse_distance",
+          reuse_distance, "must be in (0, 1]");
+  require(std::isfinite(neighbourhood) && neighbourhood >= 1 && neighbourhood <= 10, p, "neighbourhood",
+          neighbourhood, "must be in [1, 10]");
+  require(std::isfinite(initial_radius) && initial_radius > 0 && initial_radius <= 1, p, "initial_radius",
+          initial_radius, "must be in (0, 1]");
+  require(std::isfinite(min_radius) && min_radius > 0 && min_radius <= initial_radius, p, "min_radius", min_radius,
+          "must be in (0, initial_radius = " + format_number(initial_radius) + "]");
+  require(std::isfinite(max_radius) && max_radius >= initial_radius && max_radius <= 1, p, "max_radius", max_radius,
+          "must be in [initial_radius = " + format_number(initial_radius) + ", 1]");
+  require(std::isfinite(shrink_factor) && shrink_factor > 0 && shrink_factor < 1, p, "shrink_factor", shrink_factor,
+          "must be in (0, 1)");
+  require(std::isfinite(expand_factor) && expand_factor >= 1 && expand_factor <= 100, p, "expand_factor",
+          expand_factor, "must be in [1, 100]");
+  require(std::isfinite(rho_shrink) && rho_shrink >= 0 && rho_shrink < 1, p, "rho_shrink", rho_shrink,
+          "must be in [0, 1)");
+  require(std::isfinite(rho_expand_low) && rho_expand_low > rho_shrink, p, "rho_expand_low", rho_expand_low,
+          "must be > rho_shrink = " + format_number(rho_shrink));
+  require(std::isfinite(rho_expand_high) && rho_expand_high >= rho_expand_low, p, "rho_expand_high",
+          rho_expand_high, "must be >= rho_expand_low = " + format_number(rho_expand_low));
+  require(std::isfinite(penalty_initial) && penalty_initial >= 0, p, "penalty_initial", penalty_initial,
+          "must be >= 0 (0: automatic)");
+  require(std::isfinite(penalty_multiplier_factor) && penalty_multiplier_factor >= 1, p, "penalty_multiplier_factor",
+          penalty_multiplier_factor, "must be >= 1");
+  require(stall_iterations >= 1, p, "stall_iterations", stall_iterations, "must be >= 1");
+  require(std::isfinite(stall_tolerance) && stall_tolerance >= 0, p, "stall_tolerance", stall_tolerance,
+          "must be >= 0");
+  require(subproblem_max_evaluations >= 10, p, "subproblem_max_evaluations", subproblem_max_evaluations,
+          "must be >= 10");
+  require(std::isfinite(kriging_nugget) && kriging_nugget > 0 && kriging_nugget < 1, p, "kriging_nugget",
+          kriging_nugget, "must be in (0, 1)");
+  if (surrogate == "quadratic" && doe == "koshal")
+    throw ConfigError(p + ".doe", doe, "koshal (n+1 points) cannot determine a quadratic surrogate; use auto, axial, "
+                                       "central_composite or lhs");
+}
+
+SaoOptions read_sao_options(YamlReader& r) {
+  SaoOptions o;
+  o.surrogate = r.get_choice_or("surrogate", o.surrogate, surrogate_choices());
+  o.doe = r.get_choice_or("doe", o.doe, doe_choices());
+  o.doe_points = static_cast<int>(r.get_int_or("doe_points", o.doe_points, Rule::in_range(0, 100000)));
+  o.reuse_distance = r.get_double_or("reuse_distance", o.reuse_distance);
+  o.neighbourhood = r.get_double_or("neighbourhood", o.neighbourhood);
+  o.initial_radius = r.get_double_or("initial_radius", o.initial_radius);
+  o.min_radius = r.get_double_or("min_radius", o.min_radius);
+  o.max_radius = r.get_double_or("max_radius", o.max_radius);
+  o.shrink_factor = r.get_double_or("shrink_factor", o.shrink_factor);
+  o.expand_factor = r.get_double_or("expand_factor", o.expand_factor);
+  o.rho_shrink = r.get_double_or("rho_shrink", o.rho_shrink);
+  o.rho_expand_low = r.get_double_or("rho_expand_low", o.rho_expand_low);
+  o.rho_expand_high = r.get_double_or("rho_expand_high", o.rho_expand_high);
+  o.penalty_initial = r.get_double_or("penalty_initial", o.penalty_initial);
+  o.penalty_multiplier_factor = r.get_double_or("penalty_multiplier_factor", o.penalty_multiplier_factor);
+  o.stall_iterations = static_cast<int>(r.get_int_or("stall_iterations", o.stall_iterations, Rule::in_range(1, 1e6)));
+  o.stall_tolerance = r.get_double_or("stall_tolerance", o.stall_tolerance);
+  o.subproblem_solver = r.get_choice_or("subproblem_solver", o.subproblem_solver, solver_choices());
+  o.subproblem_max_evaluations = static_cast<int>(
+      r.get_int_or("subproblem_max_evaluations", o.subproblem_max_evaluations, Rule::in_range(10, 1e7)));
+  o.kriging_nugget = r.get_double_or("kriging_nugget", o.kriging_nugget);
+  r.finish();
+  o.validate(r.path().empty() ? "sao" : r.path());
+  return o;
+}
+
+bool is_sao_algorithm(const std::string& name) {
+  std::string u = name;
+  std::transform(u.begin(), u.end(), u.begin(), [](unsigned char c) { return std::toupper(c); });
+  return u == "SAO";
+}
+
+OptimizationResult minimize_any(Problem& problem, const OptimizerOptions& options, const SaoOptions& sao,
+                                std::vector<double> x0, const EvaluationCallback& callback) {
+  if (is_sao_algorithm(options.algorithm)) return minimize_sao(problem, options, sao, std::move(x0), callback);
+  return minimize(problem, options, std::move(x0), callback);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The algorithm
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+extern "C" void abuopt_sao_sigint_handler(int) { abuopt::opt::detail::interrupt_flag().store(true); }
+
+// Installs the SIGINT handler for the run and restores the previous one (as minimize() does).
+class SaoSigintGuard {
+ public:
+  explicit SaoSigintGuard(bool enable) : enabled_(enable) {
+    if (!enabled_) return;
+    std::lock_guard<std::mutex> lock(mutex());
+    if (users()++ == 0) {
+      struct sigaction sa {};
+      sa.sa_handler = abuopt_sao_sigint_handler;
+      sigemptyset(&sa.sa_mask);
+      sigaction(SIGINT, &sa, &previous());
+    }
+  }
+  ~SaoSigintGuard() {
+    if (!enabled_) return;
+    std::lock_guard<std::mutex> lock(mutex());
+    if (--users() == 0) sigaction(SIGINT, &previous(), nullptr);
+  }
+  SaoSigintGuard(const SaoSigintGuard&) = delete;
+  SaoSigintGuard& operator=(const SaoSigintGuard&) = delete;
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  static int& users() {
+    static int u = 0;
+    return u;
+  }
+  static struct sigaction& previous() {
+    static struct sigaction p {};
+    return p;
+  }
+  bool enabled_;
+};
+
+struct OptDeleter {
+  void operator()(nlopt_opt o) const { nlopt_destroy(o); }
+};
+using OptPtr = std::unique_ptr<std::remove_pointer_t<nlopt_opt>, OptDeleter>;
+
+// One known point (evaluated in this run, or taken from an archive).
+struct KnownPoint {
+  Eigen::VectorXd z;  // unit box
+  double f = kInf;
+  std::vector<double> g, h;
+  bool ok = false;
+  double l1_violation = kInf;  // sum max(0, g) + sum |h|
+};
+
+// The surrogates of one iteration, in local coordinates s.
+struct Models {
+  std::unique_ptr<surrogate::Surrogate> f;
+  std::vector<std::unique_ptr<surrogate::Surrogate>> g, h;
+  std::string basis;
+
+  double l1(const Eigen::VectorXd& s) const {
+    double v = 0;
+    for (const auto& m : g) v += std::max(0.0, m->value(s));
+    for (const auto& m : h) v += std::fabs(m->value(s));
+    return v;
+  }
+  double max_violation(const Eigen::VectorXd& s) const {
+    double v = 0;
+    for (const auto& m : g) v = std::max(v, m->value(s));
+    for (const auto& m : h) v = std::max(v, std::fabs(m->value(s)));
+    return v;
+  }
+};
+
+// NLopt callbacks on the surrogates.
+struct SubContext {
+  const Models* models;
+  bool feasibility_phase;
+};
+
+double sub_objective(unsigned n, const double* s, double* grad, void* data) {
+  const SubContext& c = *static_cast<SubContext*>(data);
+  const Eigen::Map<const Eigen::VectorXd> x(s, n);
+  const Eigen::VectorXd xs = x;
+  if (!c.feasibility_phase) {
+    if (grad) {
+      const Eigen::VectorXd gr = c.models->f->gradient(xs);
+      std::copy(gr.data(), gr.data() + n, grad);
+    }
+    return c.models->f->value(xs);
+  }
+  // sum max(0, g)^2 + sum h^2
+  double p = 0;
+  Eigen::VectorXd gr = Eigen::VectorXd::Zero(n);
+  for (const auto& m : c.models->g) {
+    const double v = m->value(xs);
+    if (v > 0) {
+      p += v * v;
+      if (grad) gr += 2 * v * m->gradient(xs);
+    }
+  }
+  for (const auto& m : c.models->h) {
+    const double v = m->value(xs);
+    p += v * v;
+    if (grad) gr += 2 * v * m->gradient(xs);
+  }
+  if (grad) std::copy(gr.data(), gr.data() + n, grad);
+  return p;
+}
+
+template <bool Equality>
+void sub_constraints(unsigned m, double* result, unsigned n, const double* s, double* grad, void* data) {
+  const SubContext& c = *static_cast<SubContext*>(data);
+  const Eigen::VectorXd xs = Eigen::Map<const Eigen::VectorXd>(s, n);
+  const auto& models = Equality ? c.models->h : c.models->g;
+  for (unsigned i = 0; i < m; ++i) {
+    result[i] = models[i]->value(xs);
+    if (grad) {
+      const Eigen::VectorXd gr = models[i]->gradient(xs);
+      std::copy(gr.data(), gr.data() + n, grad + static_cast<std::size_t>(i) * n);
+    }
+  }
+}
+
+class SaoRun {
+ public:
+  SaoRun(Problem& problem, const OptimizerOptions& options, const SaoOptions& sao, detail::EvaluationDriver& driver)
+      : problem_(problem), options_(options), sao_(sao), driver_(driver), variables_(problem.variables()) {
+    n_ = static_cast<int>(variables_.size());
+    m_ineq_ = driver.n_inequality();
+    m_eq_ = driver.n_equality();
+  }
+
+  TerminationReason reason = TerminationReason::failure;
+  std::string message;
+  long iterations = 0;
+
+  void run(const std::vector<double>& x0);
+
+ private:
+  // ---- coordinates ----
+  Eigen::VectorXd to_z(const std::vector<double>& x) const {
+    Eigen::VectorXd z(n_);
+    for (int i = 0; i < n_; ++i) {
+      const Variable& v = variables_[i];
+      z[i] = std::clamp((x[i] - v.lower) / (v.upper - v.lower), 0.0, 1.0);
+    }
+    return z;
+  }
+  std::vector<double> to_y(const Eigen::VectorXd& z) const {  // driver coordinates x / scale
+    std::vector<double> y(n_);
+    for (int i = 0; i < n_; ++i) {
+      const Variable& v = variables_[i];
+      const double x = std::clamp(v.lower + z[i] * (v.upper - v.lower), v.lower, v.upper);
+      y[i] = x / v.scale;
+    }
+    return y;
+  }
+  Eigen::VectorXd to_s(const Eigen::VectorXd& z) const { return (z - centre_z_) / radius_; }
+  Eigen::VectorXd from_s(const Eigen::VectorXd& s) const {
+    return (centre_z_ + radius_ * s).cwiseMax(0.0).cwiseMin(1.0);
+  }
+  bool in_region(const Eigen::VectorXd& z, double factor = 1.0) const {
+    return ((z - centre_z_).cwiseAbs().maxCoeff()) <= factor * radius_ * (1 + 1e-9);
+  }
+
+  // ---- points ----
+  // Evaluates z on the true problem; the index into known_, or nullopt once the run is stopped.
+  std::optional<std::size_t> evaluate(const Eigen::VectorXd& z);
+  KnownPoint make_point(const Eigen::VectorXd& z, const Evaluation& e) const;
+  double merit(const KnownPoint& p) const {
+    if (!p.ok) return kInf;
+    return feasibility_phase_ ? p.l1_violation : p.f + mu_ * p.l1_violation;
+  }
+  void load_archive();
+
+  // ---- one iteration ----
+  std::string planned_basis() const;
+  int wanted_points(const std::string& basis) const;
+  bool fill_region(const std::string& basis);  // false: stopped
+  std::optional<Models> fit(const std::string& basis) const;
+  Eigen::VectorXd solve_subproblem(const Models& models, bool& feasibility_phase);
+  Eigen::VectorXd run_nlopt(const Models& models, bool feasibility_phase, const Eigen::VectorXd& start,
+                            const Eigen::VectorXd& lo, const Eigen::VectorXd& hi) const;
+  void update_penalty(const Models& models, const Eigen::VectorXd& s);
+  std::unique_ptr<surrogate::Surrogate> make_model(const std::string& basis) const;
+
+  Problem& problem_;
+  const OptimizerOptions& options_;
+  const SaoOptions& sao_;
+  detail::EvaluationDriver& driver_;
+  std::vector<Variable> variables_;
+  int n_ = 0;
+  std::size_t m_ineq_ = 0, m_eq_ = 0;
+
+  std::vector<KnownPoint> known_;
+  std::map<const detail::EvaluatedPoint*, std::size_t> by_driver_point_;
+  Eigen::VectorXd centre_z_;
+  std::size_t centre_ = 0;
+  double radius_ = 0.1;
+  double mu_ = 1.0;
+  bool feasibility_phase_ = false;
+};
+
+KnownPoint SaoRun::make_point(const Eigen::VectorXd& z, const Evaluation& e) const {
+  KnownPoint p;
+  p.z = z;
+  p.ok = e.ok && std::isfinite(e.objective) && e.inequality.size() == m_ineq_ && e.equality.size() == m_eq_;
+  p.f = p.ok ? e.objective : kInf;
+  p.g = e.inequality;
+  p.h = e.equality;
+  if (p.ok) {
+    double v = 0;
+    for (double gi : p.g) v += std::max(0.0, gi);
+    for (double hj : p.h) v += std::fabs(hj);
+    p.l1_violation = v;
+    if (!std::isfinite(v)) p.ok = false;
+  }
+  return p;
+}
+
+std::optional<std::size_t> SaoRun::evaluate(const Eigen::VectorXd& z) {
+  const std::vector<double> y = to_y(z);
+  const detail::EvaluatedPoint* p = driver_.evaluate(y.data());
+  if (!p) return std::nullopt;
+  if (auto it = by_driver_point_.find(p); it != by_driver_point_.end()) return it->second;
+  known_.push_back(make_point(to_z(p->x), p->e));
+  by_driver_point_.emplace(p, known_.size() - 1);
+  return known_.size() - 1;
+}
+
+void SaoRun::load_archive() {
+  if (!sao_.archive) return;
+  for (const EvaluationArchive::Entry& entry : sao_.archive->entries()) {
+    if (entry.x.size() != static_cast<std::size_t>(n_)) continue;
+    bool inside = true;
+    for (int i = 0; i < n_; ++i)
+      inside = inside && std::isfinite(entry.x[i]) && entry.x[i] >= variables_[i].lower &&
+               entry.x[i] <= variables_[i].upper;
+    if (!inside) continue;
+    known_.push_back(make_point(to_z(entry.x), entry.evaluation));
+  }
+}
+
+std::string SaoRun::planned_basis() const { return sao_.surrogate; }
+
+int SaoRun::wanted_points(const std::string& basis) const {
+  if (sao_.doe_points > 0) return sao_.doe_points;
+  using surrogate::Basis;
+  if (basis == "linear") return n_ + 1;
+  if (basis == "interactions") return surrogate::terms_count(Basis::kInteractions, n_);
+  if (basis == "quadratic") return surrogate::terms_count(Basis::kQuadratic, n_);
+  return 2 * n_ + 1;  // auto, pure_quadratic, kriging
+}
+
+// Candidate DOE designs in [-1,1]^n for the region, in order of preference.
+bool SaoRun::fill_region(const std::string& basis) {
+  const int wanted = wanted_points(basis);
+  Eigen::VectorXd lo(n_), hi(n_);  // the region in local coordinates
+  for (int i = 0; i < n_; ++i) {
+    lo[i] = (std::max(0.0, centre_z_[i] - radius_) - centre_z_[i]) / radius_;
+    hi[i] = (std::min(1.0, centre_z_[i] + radius_) - centre_z_[i]) / radius_;
+  }
+  // known points in the region (failed ones cover space but do not count)
+  std::vector<Eigen::VectorXd> occupied;
+  int count = 0;
+  for (const KnownPoint& p : known_)
+    if (in_region(p.z)) {
+      occupied.push_back(to_s(p.z));
+      if (p.ok) ++count;
+    }
+
+  std::string doe = sao_.doe;
+  if (doe == "auto") doe = basis == "linear" ? "koshal" : basis == "kriging" ? "lhs" : "axial";
+  std::vector<Eigen::VectorXd> candidates;
+  auto add_rows = [&](const Eigen::MatrixXd& d, bool box_mapped) {
+    for (int r = 0; r < d.rows(); ++r) {
+      Eigen::VectorXd s = d.row(r).transpose();
+      if (box_mapped) s = 0.5 * (lo + hi) + 0.5 * (hi - lo).cwiseProduct(s);
+      candidates.push_back(s.cwiseMax(lo).cwiseMin(hi));
+    }
+  };
+  auto axial = [&] {
+    Eigen::MatrixXd d = Eigen::MatrixXd::Zero(2 * n_ + 1, n_);
+    for (int i = 0; i < n_; ++i) {
+      d(1 + 2 * i, i) = 1;
+      d(2 + 2 * i, i) = -1;
+    }
+    return d;
+  };
+  const std::uint64_t seed = options_.seed * 1000003ULL + static_cast<std::uint64_t>(iterations);
+  surrogate::LatinHypercubeOptions lhs;
+  lhs.points = std::max(wanted, 2);
+  lhs.seed = seed;
+  lhs.candidates = 20;
+  if (doe == "koshal") {
+    add_rows(surrogate::koshal_linear(n_), false);
+    add_rows(axial(), false);
+  } else if (doe == "axial") {
+    add_rows(axial(), false);
+    if (n_ <= 10) {
+      surrogate::CentralCompositeOptions cc;
+      cc.center_points = 0;
+      add_rows(surrogate::central_composite(n_, cc).topRows(1 << n_), false);
+    }
+  } else if (doe == "central_composite") {
+    surrogate::CentralCompositeOptions cc;
+    cc.center_points = 1;
+    add_rows(surrogate::central_composite(n_, cc), false);
+  }
+  add_rows(surrogate::latin_hypercube(n_, lhs), true);  // always as the filler
+
+  auto distance_to_occupied = [&](const Eigen::VectorXd& s) {
+    double d = kInf;
+    for (const auto& o : occupied) d = std::min(d, (s - o).cwiseAbs().maxCoeff());
+    return d;
+  };
+  std::vector<bool> used(candidates.size(), false);
+  while (count < wanted) {
+    // the first candidate (in preference order) that is not covered by a known point; among the
+    // preferred design (before the LHS filler) the farthest one from the known points
+    std::size_t best = candidates.size();
+    double best_d = -1;
+    for (std::size_t k = 0; k < candidates.size(); ++k) {
+      if (used[k]) continue;
+      const double d = distance_to_occupied(candidates[k]);
+      if (d < sao_.reuse_distance) {
+        used[k] = true;
+        continue;
+      }
+      if (d > best_d) {
+        best_d = d;
+        best = k;
+      }
+    }
+    if (best == candidates.size()) break;
+    used[best] = true;
+    const auto idx = evaluate(from_s(candidates[best]));
+    if (!idx) return false;
+    occupied.push_back(to_s(known_[*idx].z));
+    if (known_[*idx].ok) ++count;
+  }
+  // a linear model must be determined: add axial points until [1 s] has full column rank
+  auto rank = [&] {
+    std::vector<Eigen::VectorXd> rows;
+    for (const KnownPoint& p : known_)
+      if (p.ok && in_region(p.z)) rows.push_back(to_s(p.z));
+    if (rows.empty()) return Eigen::Index{0};
+    Eigen::MatrixXd a(rows.size(), n_ + 1);
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      a(r, 0) = 1;
+      a.row(r).tail(n_) = rows[r].transpose();
+    }
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(a);
+    qr.setThreshold(1e-6);
+    return qr.rank();
+  };
+  const Eigen::MatrixXd ax = axial();
+  for (int r = 1; r < ax.rows() && rank() < n_ + 1; ++r) {
+    const Eigen::VectorXd s = Eigen::VectorXd(ax.row(r).transpose()).cwiseMax(lo).cwiseMin(hi);
+    if (distance_to_occupied(s) < 1e-9) continue;
+    const auto idx = evaluate(from_s(s));
+    if (!idx) return false;
+    occupied.push_back(to_s(known_[*idx].z));
+  }
+  return true;
+}
+
+std::unique_ptr<surrogate::Surrogate> SaoRun::make_model(const std::string& basis) const {
+  if (basis == "kriging") {
+    surrogate::KrigingOptions k;
+    k.nugget = sao_.kriging_nugget;
+    k.starts = 2;
+    k.max_evaluations = 200;
+    return surrogate::make_surrogate("kriging", &k);
+  }
+  return surrogate::make_surrogate(basis);
+}
+
+std::optional<Models> SaoRun::fit(const std::string& requested) const {
+  std::vector<Eigen::VectorXd> s;
+  std::vector<double> w;
+  std::vector<const KnownPoint*> pts;
+  int in_region_count = 0;
+  for (const KnownPoint& p : known_) {
+    if (!p.ok) continue;
+    const Eigen::VectorXd sp = to_s(p.z);
+    const double d = sp.cwiseAbs().maxCoeff();
+    if (d > sao_.neighbourhood * (1 + 1e-9)) continue;
+    s.push_back(sp);
+    w.push_back(d <= 1 + 1e-9 ? 1.0 : 1.0 / std::pow(d, 4));
+    pts.push_back(&p);
+    if (d <= 1 + 1e-9) ++in_region_count;
+  }
+  const int m = static_cast<int>(s.size());
+  if (m < 2) return std::nullopt;
+  Eigen::MatrixXd X(m, n_);
+  Eigen::VectorXd W(m);
+  for (int i = 0; i < m; ++i) {
+    X.row(i) = s[i].transpose();
+    W[i] = w[i];
+  }
+  using surrogate::Basis;
+  std::vector<std::string> order;
+  if (requested == "auto") order = {"quadratic", "pure_quadratic", "linear"};
+  else if (requested == "kriging") order = {"kriging", "linear"};
+  else order = {requested, "linear"};
+  for (const std::string& basis : order) {
+    if (basis != "kriging" && surrogate::terms_count(surrogate::basis_from_string(basis), n_) > m) continue;
+    try {
+      Models models;
+      models.basis = basis;
+      auto fit_one = [&](const std::function<double(const KnownPoint&)>& value) {
+        Eigen::VectorXd y(m);
+        for (int i = 0; i < m; ++i) y[i] = value(*pts[i]);
+        if (basis == "kriging") {
+          // kriging interpolates: region points and neighbours alike
+          auto model = make_model(basis);
+          model->fit(X, y);
+          return model;
+        }
+        auto rs = std::make_unique<surrogate::ResponseSurface>(surrogate::basis_from_string(basis));
+        rs->fit(X, y, W);
+        return std::unique_ptr<surrogate::Surrogate>(std::move(rs));
+      };
+      models.f = fit_one([](const KnownPoint& p) { return p.f; });
+      for (std::size_t i = 0; i < m_ineq_; ++i) models.g.push_back(fit_one([i](const KnownPoint& p) { return p.g[i]; }));
+      for (std::size_t j = 0; j < m_eq_; ++j) models.h.push_back(fit_one([j](const KnownPoint& p) { return p.h[j]; }));
+      return models;
+    } catch (const std::exception&) {
+      continue;  // rank-deficient or too few points: a simpler basis
+    }
+  }
+  return std::nullopt;
+}
+
+Eigen::VectorXd SaoRun::run_nlopt(const Models& models, bool feasibility_phase, const Eigen::VectorXd& start,
+                                  const Eigen::VectorXd& lo, const Eigen::VectorXd& hi) const {
+  const unsigned n = static_cast<unsigned>(n_);
+  const bool slsqp = sao_.subproblem_solver == "slsqp";
+  OptPtr opt(nlopt_create(slsqp ? NLOPT_LD_SLSQP : NLOPT_LN_COBYLA, n));
+  if (!opt) return start;
+  SubContext ctx{&models, feasibility_phase};
+  nlopt_set_lower_bounds(opt.get(), lo.data());
+  nlopt_set_upper_bounds(opt.get(), hi.data());
+  nlopt_set_min_objective(opt.get(), sub_objective, &ctx);
+  if (!feasibility_phase) {
+    const double tol = 0.1 * options_.constraint_tolerance;
+    if (m_ineq_ > 0) {
+      std::vector<double> t(m_ineq_, tol);
+      nlopt_add_inequality_mconstraint(opt.get(), static_cast<unsigned>(m_ineq_), sub_constraints<false>, &ctx,
+                                       t.data());
+    }
+    if (m_eq_ > 0) {
+      std::vector<double> t(m_eq_, tol);
+      nlopt_add_equality_mconstraint(opt.get(), static_cast<unsigned>(m_eq_), sub_constraints<true>, &ctx, t.data());
+    }
+  }
+  nlopt_set_xtol_abs1(opt.get(), 1e-10);
+  nlopt_set_ftol_rel(opt.get(), 1e-14);
+  nlopt_set_maxeval(opt.get(), sao_.subproblem_max_evaluations);
+  if (!slsqp) {
+    std::vector<double> dx(n);
+    for (unsigned i = 0; i < n; ++i) dx[i] = std::max(1e-3, 0.25 * (hi[i] - lo[i]));
+    nlopt_set_initial_step(opt.get(), dx.data());
+  }
+  std::vector<double> x(start.data(), start.data() + n);
+  for (unsigned i = 0; i < n; ++i) x[i] = std::clamp(x[i], lo[i], hi[i]);
+  double f = 0;
+  nlopt_optimize(opt.get(), x.data(), &f);  // whatever the code, x holds its last iterate
+  Eigen::VectorXd out = Eigen::Map<Eigen::VectorXd>(x.data(), n);
+  for (int i = 0; i < n_; ++i)
+    if (!std::isfinite(out[i])) out[i] = start[i];
+  return out.cwiseMax(lo).cwiseMin(hi);
+}
+
+Eigen::VectorXd SaoRun::solve_subproblem(const Models& models, bool& feasibility_phase) {
+  Eigen::VectorXd lo(n_), hi(n_);
+  for (int i = 0; i < n_; ++i) {
+    lo[i] = (std::max(0.0, centre_z_[i] - radius_) - centre_z_[i]) / radius_;
+    hi[i] = (std::min(1.0, centre_z_[i] + radius_) - centre_z_[i]) / radius_;
+  }
+  // starts: the centre and the best known point of the region (by the current merit)
+  std::vector<Eigen::VectorXd> starts = {Eigen::VectorXd::Zero(n_)};
+  {
+    double best = merit(known_[centre_]);
+    std::optional<Eigen::VectorXd> s_best;
+    for (const KnownPoint& p : known_)
+      if (p.ok && in_region(p.z) && merit(p) < best) {
+        best = merit(p);
+        s_best = to_s(p.z);
+      }
+    if (s_best) starts.push_back(*s_best);
+  }
+  const double tol = options_.constraint_tolerance;
+  std::optional<Eigen::VectorXd> best_s;
+  double best_f = kInf;
+  for (const auto& st : starts) {
+    const Eigen::VectorXd s = run_nlopt(models, false, st, lo, hi);
+    if (models.max_violation(s) > std::max(tol, 1e-12)) continue;
+    const double f = models.f->value(s);
+    if (f < best_f) {
+      best_f = f;
+      best_s = s;
+    }
+  }
+  if (best_s) {
+    feasibility_phase = false;
+    return *best_s;
+  }
+  // no surrogate-feasible point found in the region: minimise the predicted violation
+  feasibility_phase = true;
+  double best_v = kInf;
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(n_);
+  for (const auto& st : starts) {
+    const Eigen::VectorXd s = run_nlopt(models, true, st, lo, hi);
+    const double v = models.l1(s);
+    if (v < best_v) {
+      best_v = v;
+      out = s;
+    }
+  }
+  return out;
+}
+
+// mu >= factor * max |lambda|, the multipliers estimated by least squares from the surrogate
+// gradients at s (free variables, active inequality constraints and the equalities).
+void SaoRun::update_penalty(const Models& models, const Eigen::VectorXd& s) {
+  if (m_ineq_ + m_eq_ == 0) return;
+  Eigen::VectorXd lo(n_), hi(n_);
+  for (int i = 0; i < n_; ++i) {
+    lo[i] = (std::max(0.0, centre_z_[i] - radius_) - centre_z_[i]) / radius_;
+    hi[i] = (std::min(1.0, centre_z_[i] + radius_) - centre_z_[i]) / radius_;
+  }
+  std::vector<int> free;
+  for (int i = 0; i < n_; ++i)
+    if (s[i] > lo[i] + 1e-7 && s[i] < hi[i] - 1e-7) free.push_back(i);
+  std::vector<Eigen::VectorXd> grads;
+  for (const auto& g : models.g)
+    if (g->value(s) >= -1e-6 * std::max(1.0, std::fabs(g->value(Eigen::VectorXd::Zero(n_))))) grads.push_back(g->gradient(s));
+  for (const auto& h : models.h) grads.push_back(h->gradient(s));
+  if (free.empty() || grads.empty()) return;
+  const Eigen::VectorXd gf = models.f->gradient(s);
+  Eigen::MatrixXd A(free.size(), grads.size());
+  Eigen::VectorXd b(free.size());
+  for (std::size_t r = 0; r < free.size(); ++r) {
+    b[r] = -gf[free[r]];
+    for (std::size_t c = 0; c < grads.size(); ++c) A(r, c) = grads[c][free[r]];
+  }
+  const Eigen::VectorXd lambda = A.completeOrthogonalDecomposition().solve(b);
+  if (!lambda.allFinite()) return;
+  const double need = sao_.penalty_multiplier_factor * lambda.cwiseAbs().maxCoeff();
+  if (need > mu_ && need < 1e12) mu_ = need;
+}
+
+void SaoRun::run(const std::vector<double>& x0) {
+  load_archive();
+  radius_ = sao_.initial_radius;
+  centre_z_ = to_z(x0);
+  const auto c0 = evaluate(centre_z_);
+  if (!c0) return;
+  centre_ = *c0;
+  centre_z_ = known_[centre_].z;
+  mu_ = sao_.penalty_initial > 0 ? sao_.penalty_initial
+                                 : 10.0 * std::max(1.0, known_[centre_].ok ? std::fabs(known_[centre_].f) : 1.0);
+
+  int stalled = 0;
+  while (true) {
+    if (radius_ < sao_.min_radius) {
+      reason = TerminationReason::converged_xtol;
+      message = "trust region radius " + format_number(radius_) + " below min_radius " +
+                format_number(sao_.min_radius);
+      return;
+    }
+    if (stalled >= sao_.stall_iterations) {
+      reason = TerminationReason::converged_ftol;
+      message = "no improvement of the merit by more than stall_tolerance in " +
+                std::to_string(sao_.stall_iterations) + " iterations";
+      return;
+    }
+    if (options_.max_iterations > 0 && iterations >= options_.max_iterations) {
+      reason = TerminationReason::max_iterations;
+      message = "iteration limit of " + std::to_string(options_.max_iterations) + " reached";
+      return;
+    }
+    ++iterations;
+
+    const std::string basis = planned_basis();
+    if (!fill_region(basis)) return;
+    std::optional<Models> models = fit(basis);
+    if (!models) {  // nothing to fit (e.g. every point failed): try a smaller region
+      radius_ *= sao_.shrink_factor;
+      ++stalled;
+      continue;
+    }
+    bool phase1 = false;
+    const Eigen::VectorXd s = solve_subproblem(*models, phase1);
+    feasibility_phase_ = phase1;
+    if (!phase1) update_penalty(*models, s);
+
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n_);
+    auto predicted_merit = [&](const Eigen::VectorXd& x) {
+      return phase1 ? models->l1(x) : models->f->value(x) + mu_ * models->l1(x);
+    };
+    if (!phase1 && models->l1(zero) > 0) {
+      // the step must reduce the predicted merit: mu >= 2 (f^(s) - f^(0)) / V^(0)
+      const double df = models->f->value(s) - models->f->value(zero);
+      if (df > 0) mu_ = std::max(mu_, 2 * df / models->l1(zero));
+    }
+    const double predicted = predicted_merit(zero) - predicted_merit(s);
+    const double step = s.cwiseAbs().maxCoeff();
+    if (!(predicted > 1e-14 * std::max(1.0, std::fabs(predicted_merit(zero)))) || step < 1e-9) {
+      // the surrogate sees no better point in the region: refine the model in a smaller region
+      radius_ *= sao_.shrink_factor;
+      ++stalled;
+      continue;
+    }
+    const auto cand = evaluate(from_s(s));
+    if (!cand) return;
+    const double phi_c = merit(known_[centre_]);
+    const double phi_x = merit(known_[*cand]);
+    const double actual = phi_c - phi_x;
+    const double rho = actual / predicted;
+    const bool on_boundary = step >= 1 - 1e-3;
+    if (!(actual > 0)) {
+      radius_ *= sao_.shrink_factor;  // rejected: keep the centre
+    } else {
+      if (rho <= sao_.rho_shrink) radius_ *= sao_.shrink_factor;
+      else if (rho >= sao_.rho_expand_low && rho <= sao_.rho_expand_high && on_boundary)
+        radius_ = std::min(sao_.max_radius, radius_ * sao_.expand_factor);
+      centre_ = *cand;
+      centre_z_ = known_[centre_].z;
+    }
+    const bool progress = actual > sao_.stall_tolerance * std::max(1.0, std::fabs(phi_c));
+    stalled = progress ? 0 : stalled + 1;
+  }
+}
+
+}  // namespace
+
+OptimizationResult minimize_sao(Problem& problem, const OptimizerOptions& options, const SaoOptions& sao,
+                                std::vector<double> x0, const EvaluationCallback& callback) {
+  {
+    OptimizerOptions check = options;  // the algorithm name belongs to minimize()
+    check.algorithm = "COBYLA";
+    check.local_algorithm.clear();
+    check.validate();
+  }
+  sao.validate();
+  check_problem(problem);
+  if (x0.empty()) x0 = problem.initial_point();
+  check_design_vector(problem, x0, "starting point");
+
+  SaoSigintGuard sigint(options.handle_sigint);
+  detail::interrupt_flag().store(false);
+  detail::EvaluationDriver driver(problem, options, callback);
+  SaoRun run(problem, options, sao, driver);
+  try {
+    run.run(x0);
+  } catch (const std::exception& ex) {
+    run.reason = TerminationReason::failure;
+    run.message = std::string("SAO threw: ") + ex.what();
+  }
+
+  OptimizationResult r;
+  r.problem_name = problem.name();
+  r.algorithm = "SAO(" + sao.surrogate + ")";
+  r.x0 = x0;
+  r.iterations = run.iterations;
+  for (const Variable& v : problem.variables()) r.variable_names.push_back(v.name);
+  r.inequality_names = problem.inequality_names();
+  r.equality_names = problem.equality_names();
+  driver.fill(r);
+  if (driver.stopped()) {
+    r.reason = *driver.stop_reason();
+    r.message = driver.stop_message();
+  } else {
+    r.reason = run.reason;
+    r.message = run.message;
+  }
+  if (is_convergence(r.reason) && !r.has_feasible_point()) {
+    r.message = "SAO stopped (" + to_string(r.reason) + ": " + r.message +
+                ") but no evaluated point is feasible within the tolerance " +
+                format_number(options.constraint_tolerance) +
+                (r.x.empty() ? "" : " (smallest violation " + format_number(r.max_violation) + ")");
+    r.reason = TerminationReason::infeasible;
+  }
+  if (detail::interrupt_flag().load()) detail::interrupt_flag().store(false);
+  return r;
+}
+
+}  // namespace abuopt::opt

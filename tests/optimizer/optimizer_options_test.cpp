@@ -1,0 +1,112 @@
+// Options: defaults are valid, YAML keys read with paths in messages, bad values rejected.
+#include "abuopt/optimizer/optimizer_options.hpp"
+
+#include <gtest/gtest.h>
+
+#include "abuopt/common/config_error.hpp"
+#include "abuopt/optimizer/algorithms.hpp"
+
+namespace {
+
+using namespace abuopt::opt;
+using abuopt::YamlReader;
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const abuopt::ConfigError& e) {
+    return e.what();
+  }
+  return "<no error>";
+}
+
+OptimizerOptions read(const std::string& yaml) {
+  YamlReader root = YamlReader::load_string(yaml);
+  YamlReader section = root.child("optimizer");
+  return read_optimizer_options(section);
+}
+
+TEST(OptimizerOptions, DefaultsAreValid) {
+  OptimizerOptions o;
+  EXPECT_NO_THROW(o.validate());
+  EXPECT_EQ(o.algorithm, "cobyla");
+  EXPECT_EQ(o.max_evaluations, 1000);
+  EXPECT_EQ(o.finite_difference, FiniteDifference::forward);
+  EXPECT_FALSE(o.target.has_value());
+}
+
+TEST(OptimizerOptions, ReadsEveryKey) {
+  const OptimizerOptions o = read(
+      "optimizer:\n  algorithm: AugLag\n  local_algorithm: slsqp\n  max_evaluations: 250\n  max_time_s: 60\n"
+      "  max_iterations: 40\n  xtol_rel: 1e-5\n  ftol_rel: 1e-7\n  ftol_abs: 1e-9\n  target: 0.5\n"
+      "  constraint_tolerance: 1e-4\n  finite_difference: central\n  fd_relative_step: 1e-3\n  seed: 42\n"
+      "  population: 30\n  initial_step: 0.1\n  print_level: 5\n  handle_sigint: false\n  keep_history: false\n");
+  EXPECT_EQ(o.algorithm, "AugLag");
+  EXPECT_EQ(o.local_algorithm, "slsqp");
+  EXPECT_EQ(o.max_evaluations, 250);
+  EXPECT_EQ(o.max_time_s, 60);
+  EXPECT_EQ(o.max_iterations, 40);
+  EXPECT_EQ(o.xtol_rel, 1e-5);
+  EXPECT_EQ(o.ftol_rel, 1e-7);
+  EXPECT_EQ(o.ftol_abs, 1e-9);
+  EXPECT_EQ(o.target, 0.5);
+  EXPECT_EQ(o.constraint_tolerance, 1e-4);
+  EXPECT_EQ(o.finite_difference, FiniteDifference::central);
+  EXPECT_EQ(o.fd_relative_step, 1e-3);
+  EXPECT_EQ(o.seed, 42u);
+  EXPECT_EQ(o.population, 30);
+  EXPECT_EQ(o.initial_step, 0.1);
+  EXPECT_EQ(o.print_level, 5);
+  EXPECT_FALSE(o.handle_sigint);
+  EXPECT_FALSE(o.keep_history);
+}
+
+TEST(OptimizerOptions, AbsentSectionGivesDefaults) {
+  const OptimizerOptions o = read("other: 1\n");
+  EXPECT_EQ(o.algorithm, "cobyla");
+}
+
+TEST(OptimizerOptions, UnknownAlgorithmListsTheValidNames) {
+  const std::string msg = error_of([] { read("optimizer:\n  algorithm: cobila\n"); });
+  EXPECT_EQ(msg.rfind("optimizer.algorithm = cobila: unknown algorithm; valid (case-insensitive): COBYLA, BOBYQA, ", 0),
+            0u)
+      << msg;
+  for (const auto& name : algorithm_names()) EXPECT_NE(msg.find(name), std::string::npos) << name;
+  EXPECT_EQ(error_of([] {
+              OptimizerOptions o;
+              o.local_algorithm = "direct_l";
+              o.validate();
+            }),
+            "optimizer.local_algorithm = direct_l: must be a local algorithm (not global or AUGLAG)");
+}
+
+TEST(OptimizerOptions, BadValuesNameKeyValueAndRule) {
+  EXPECT_EQ(error_of([] { read("optimizer:\n  max_evaluations: 0\n"); }), "optimizer.max_evaluations = 0: must be > 0");
+  EXPECT_EQ(error_of([] { read("optimizer:\n  finite_difference: backward\n"); }),
+            "optimizer.finite_difference = backward: must be one of: forward, central");
+  EXPECT_EQ(error_of([] { read("optimizer:\n  max_evals: 10\n"); }),
+            "optimizer.max_evals = 10: unknown key (misspelt, or not valid here)");
+  EXPECT_EQ(error_of([] {
+              OptimizerOptions o;
+              o.xtol_rel = -1;
+              o.validate();
+            }),
+            "optimizer.xtol_rel = -1: must be >= 0");
+  EXPECT_EQ(error_of([] {
+              OptimizerOptions o;
+              o.fd_relative_step = 0.7;
+              o.validate();
+            }),
+            "optimizer.fd_relative_step = 0.7: must be in [0, 0.5) (0: automatic)");
+}
+
+TEST(Algorithms, NamesAreCaseInsensitive) {
+  EXPECT_EQ(find_algorithm("neldermead").name, "NELDERMEAD");
+  EXPECT_EQ(find_algorithm("Ipopt").name, "IPOPT");
+  EXPECT_TRUE(find_algorithm("slsqp").equality_constraints);
+  EXPECT_FALSE(find_algorithm("mma").equality_constraints);
+  EXPECT_TRUE(find_algorithm("auglag").needs_local);
+  EXPECT_EQ(algorithm_names().size(), algorithms().size());
+}
+
+}  // namespace
