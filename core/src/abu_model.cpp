@@ -39,7 +39,12 @@ void AbuModel::evaluate(const double* y, double W, double Wp, const BallMode* mo
   double A11 = 1, A12 = 0, A21 = 0, A22 = 1, R1 = 0, R2 = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const double bdi = y[4 + n + i];
-    const double s = std::sin(y[4 + i]), c = std::cos(y[4 + i]);
+    if (y[4 + i] != out.sc_beta[i]) {
+      out.s[i] = std::sin(y[4 + i]);
+      out.c[i] = std::cos(y[4 + i]);
+      out.sc_beta[i] = y[4 + i];
+    }
+    const double s = out.s[i], c = out.c[i];
     const double m = nd_.mbar[i];
     const double w = bdi + W;
     hx += -Wp * m * s - m * w * w * c;
@@ -48,8 +53,6 @@ void AbuModel::evaluate(const double* y, double W, double Wp, const BallMode* mo
                       Wp * (x * c + yy * s + 1.0 - 2.0 * nd_.dbar[i] * J);
     const double hl = 2.0 * xd * W * s - 2.0 * yd * W * c - x * W2 * c - yy * W2 * s - w * w +
                       2.0 * J * bdi * (nd_.dbar[i] * W - 2.0 * bdi) + Wp * (x * s - yy * c);
-    out.s[i] = s;
-    out.c[i] = c;
     out.hb[i] = hb;
     out.hl[i] = hl;
     if (modes[i] != BallMode::Stick) {

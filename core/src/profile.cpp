@@ -13,13 +13,13 @@ namespace {
 constexpr double kTwoPi = 2.0 * M_PI;
 
 // phi - sin(phi), accurate for small phi (the naive difference loses all digits as phi -> 0).
-double phi_minus_sin(double phi) {
+double phi_minus_sin(double phi, double sin_phi) {
   if (std::fabs(phi) < 0.5) {
     // phi^3/6 - phi^5/120 + phi^7/5040 - phi^9/362880 + phi^11/39916800 (error < 1e-16 rel)
     const double p2 = phi * phi;
     return phi * p2 * (1.0 / 6 - p2 * (1.0 / 120 - p2 * (1.0 / 5040 - p2 * (1.0 / 362880 - p2 / 39916800.0))));
   }
-  return phi - std::sin(phi);
+  return phi - sin_phi;
 }
 }  // namespace
 
@@ -60,10 +60,10 @@ ProfileSample StartupProfile::sample(double t) const {
   const double H = segments_[k].end_frequency_hz - f0;
   const double dt = segments_[k].duration_s;
   const double phi = kTwoPi * (t - t0) / dt;
-  const double sh = std::sin(0.5 * phi);
-  s.frequency_hz = f0 + H / kTwoPi * phi_minus_sin(phi);
+  const double sh = std::sin(0.5 * phi), ch = std::cos(0.5 * phi);  // one sincos call
+  s.frequency_hz = f0 + H / kTwoPi * phi_minus_sin(phi, 2.0 * sh * ch);
   s.rate_hz_per_s = 2.0 * H / dt * sh * sh;  // H/dt (1 - cos phi), without cancellation
-  s.accel_hz_per_s2 = kTwoPi * H / (dt * dt) * std::sin(phi);
+  s.accel_hz_per_s2 = kTwoPi * H / (dt * dt) * 2.0 * sh * ch;
   return s;
 }
 
