@@ -97,8 +97,7 @@ MonteCarloConfig read_monte_carlo_config(YamlReader& root, SimulationSetup setup
   const long seed = mc.get_int_or("seed", 0, Rule::in_range(0, 9007199254740992.0));
   st.seed = static_cast<std::uint64_t>(seed);
   st.design.seed = st.seed;
-  // has() first: YamlReader::get_bool_or does not treat an absent key as absent.
-  st.design.random_shift = mc.has("shift") ? mc.get_bool_or("shift", true) : (mc.get_string_or("shift", ""), true);
+  st.design.random_shift = mc.get_bool_or("shift", true);
   cfg.threads = static_cast<std::size_t>(mc.get_int_or("threads", 0, Rule::non_negative()));
   st.uncertain = read_uncertain_parameters(mc);
   mc.finish();

@@ -142,13 +142,12 @@ UncertainParameters read_uncertain_parameters(YamlReader& mc) {
       u.imbalance_mass.relative_lo = r[0];
       u.imbalance_mass.relative_hi = r[1];
     } else {
-      im.get_string_or("mass_relative_range", "");  // mark as read when null
+      im.get_string_or("mass_relative_range", "");  // marks a null value as read
     }
     const std::string a = im.get_choice_or("angle", "fixed", {"fixed", "uniform"});
     u.imbalance_angle.sampling = a == "uniform" ? ImbalanceAngleSampling::Uniform : ImbalanceAngleSampling::Fixed;
     if (u.imbalance_angle.sampling == ImbalanceAngleSampling::Fixed) {
-      // has() first: YamlReader::get_double_or does not treat an absent key as absent.
-      u.imbalance_angle.angle_rad = im.has("angle_rad") ? im.get_double("angle_rad") : (im.get_string_or("angle_rad", ""), 0.0);
+      u.imbalance_angle.angle_rad = im.get_double_or("angle_rad", 0.0);
     } else if (im.has("angle_rad")) {
       throw ConfigError(im.key_path("angle_rad"), yaml_value_text(im.node()["angle_rad"]),
                         "is only valid with angle: fixed (angle: uniform draws it)");
