@@ -7,6 +7,8 @@
 #include <cctype>
 #include <cmath>
 #include <csignal>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <map>
 #include <memory>
@@ -18,6 +20,7 @@
 #include <Eigen/Dense>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/optimizer/evaluation_archive.hpp"
 #include "abuopt/surrogate/doe.hpp"
 #include "abuopt/surrogate/kriging.hpp"
 #include "abuopt/surrogate/response_surface.hpp"
@@ -87,6 +90,8 @@ void SaoOptions::validate(const std::string& p) const {
           "must be > rho_shrink = " + format_number(rho_shrink));
   require(std::isfinite(rho_expand_high) && rho_expand_high >= rho_expand_low, p, "rho_expand_high",
           rho_expand_high, "must be >= rho_expand_low = " + format_number(rho_expand_low));
+  require(std::isfinite(short_step) && short_step >= 0 && short_step < 1, p, "short_step", short_step,
+          "must be in [0, 1) (0: off)");
   require(std::isfinite(penalty_initial) && penalty_initial >= 0, p, "penalty_initial", penalty_initial,
           "must be >= 0 (0: automatic)");
   require(std::isfinite(penalty_multiplier_factor) && penalty_multiplier_factor >= 1, p, "penalty_multiplier_factor",
@@ -118,6 +123,8 @@ SaoOptions read_sao_options(YamlReader& r) {
   o.rho_shrink = r.get_double_or("rho_shrink", o.rho_shrink);
   o.rho_expand_low = r.get_double_or("rho_expand_low", o.rho_expand_low);
   o.rho_expand_high = r.get_double_or("rho_expand_high", o.rho_expand_high);
+  o.correction = r.get_bool_or("correction", o.correction);
+  o.short_step = r.get_double_or("short_step", o.short_step);
   o.penalty_initial = r.get_double_or("penalty_initial", o.penalty_initial);
   o.penalty_multiplier_factor = r.get_double_or("penalty_multiplier_factor", o.penalty_multiplier_factor);
   o.stall_iterations = static_cast<int>(r.get_int_or("stall_iterations", o.stall_iterations, Rule::in_range(1, 1e6)));
@@ -203,22 +210,34 @@ struct KnownPoint {
   double l1_violation = kInf;  // sum max(0, g) + sum |h|
 };
 
-// The surrogates of one iteration, in local coordinates s.
+// The surrogates of one iteration, in local coordinates s, each plus an additive offset (the
+// zeroth-order correction that makes it match the true value at the centre).
 struct Models {
-  std::unique_ptr<surrogate::Surrogate> f;
-  std::vector<std::unique_ptr<surrogate::Surrogate>> g, h;
+  std::unique_ptr<surrogate::Surrogate> fm;
+  std::vector<std::unique_ptr<surrogate::Surrogate>> gm, hm;
+  double f_offset = 0;
+  std::vector<double> g_offset, h_offset;
   std::string basis;
+
+  std::size_t n_g() const { return gm.size(); }
+  std::size_t n_h() const { return hm.size(); }
+  double f(const Eigen::VectorXd& s) const { return fm->value(s) + f_offset; }
+  double g(std::size_t i, const Eigen::VectorXd& s) const { return gm[i]->value(s) + g_offset[i]; }
+  double h(std::size_t j, const Eigen::VectorXd& s) const { return hm[j]->value(s) + h_offset[j]; }
+  Eigen::VectorXd f_grad(const Eigen::VectorXd& s) const { return fm->gradient(s); }
+  Eigen::VectorXd g_grad(std::size_t i, const Eigen::VectorXd& s) const { return gm[i]->gradient(s); }
+  Eigen::VectorXd h_grad(std::size_t j, const Eigen::VectorXd& s) const { return hm[j]->gradient(s); }
 
   double l1(const Eigen::VectorXd& s) const {
     double v = 0;
-    for (const auto& m : g) v += std::max(0.0, m->value(s));
-    for (const auto& m : h) v += std::fabs(m->value(s));
+    for (std::size_t i = 0; i < n_g(); ++i) v += std::max(0.0, g(i, s));
+    for (std::size_t j = 0; j < n_h(); ++j) v += std::fabs(h(j, s));
     return v;
   }
   double max_violation(const Eigen::VectorXd& s) const {
     double v = 0;
-    for (const auto& m : g) v = std::max(v, m->value(s));
-    for (const auto& m : h) v = std::max(v, std::fabs(m->value(s)));
+    for (std::size_t i = 0; i < n_g(); ++i) v = std::max(v, g(i, s));
+    for (std::size_t j = 0; j < n_h(); ++j) v = std::max(v, std::fabs(h(j, s)));
     return v;
   }
 };
@@ -231,29 +250,29 @@ struct SubContext {
 
 double sub_objective(unsigned n, const double* s, double* grad, void* data) {
   const SubContext& c = *static_cast<SubContext*>(data);
-  const Eigen::Map<const Eigen::VectorXd> x(s, n);
-  const Eigen::VectorXd xs = x;
+  const Eigen::VectorXd xs = Eigen::Map<const Eigen::VectorXd>(s, n);
+  const Models& m = *c.models;
   if (!c.feasibility_phase) {
     if (grad) {
-      const Eigen::VectorXd gr = c.models->f->gradient(xs);
+      const Eigen::VectorXd gr = m.f_grad(xs);
       std::copy(gr.data(), gr.data() + n, grad);
     }
-    return c.models->f->value(xs);
+    return m.f(xs);
   }
   // sum max(0, g)^2 + sum h^2
   double p = 0;
   Eigen::VectorXd gr = Eigen::VectorXd::Zero(n);
-  for (const auto& m : c.models->g) {
-    const double v = m->value(xs);
+  for (std::size_t i = 0; i < m.n_g(); ++i) {
+    const double v = m.g(i, xs);
     if (v > 0) {
       p += v * v;
-      if (grad) gr += 2 * v * m->gradient(xs);
+      if (grad) gr += 2 * v * m.g_grad(i, xs);
     }
   }
-  for (const auto& m : c.models->h) {
-    const double v = m->value(xs);
+  for (std::size_t j = 0; j < m.n_h(); ++j) {
+    const double v = m.h(j, xs);
     p += v * v;
-    if (grad) gr += 2 * v * m->gradient(xs);
+    if (grad) gr += 2 * v * m.h_grad(j, xs);
   }
   if (grad) std::copy(gr.data(), gr.data() + n, grad);
   return p;
@@ -263,11 +282,10 @@ template <bool Equality>
 void sub_constraints(unsigned m, double* result, unsigned n, const double* s, double* grad, void* data) {
   const SubContext& c = *static_cast<SubContext*>(data);
   const Eigen::VectorXd xs = Eigen::Map<const Eigen::VectorXd>(s, n);
-  const auto& models = Equality ? c.models->h : c.models->g;
   for (unsigned i = 0; i < m; ++i) {
-    result[i] = models[i]->value(xs);
+    result[i] = Equality ? c.models->h(i, xs) : c.models->g(i, xs);
     if (grad) {
-      const Eigen::VectorXd gr = models[i]->gradient(xs);
+      const Eigen::VectorXd gr = Equality ? c.models->h_grad(i, xs) : c.models->g_grad(i, xs);
       std::copy(gr.data(), gr.data() + n, grad + static_cast<std::size_t>(i) * n);
     }
   }
@@ -574,9 +592,18 @@ std::optional<Models> SaoRun::fit(const std::string& requested) const {
         rs->fit(X, y, W);
         return std::unique_ptr<surrogate::Surrogate>(std::move(rs));
       };
-      models.f = fit_one([](const KnownPoint& p) { return p.f; });
-      for (std::size_t i = 0; i < m_ineq_; ++i) models.g.push_back(fit_one([i](const KnownPoint& p) { return p.g[i]; }));
-      for (std::size_t j = 0; j < m_eq_; ++j) models.h.push_back(fit_one([j](const KnownPoint& p) { return p.h[j]; }));
+      models.fm = fit_one([](const KnownPoint& p) { return p.f; });
+      for (std::size_t i = 0; i < m_ineq_; ++i) models.gm.push_back(fit_one([i](const KnownPoint& p) { return p.g[i]; }));
+      for (std::size_t j = 0; j < m_eq_; ++j) models.hm.push_back(fit_one([j](const KnownPoint& p) { return p.h[j]; }));
+      models.g_offset.assign(m_ineq_, 0.0);
+      models.h_offset.assign(m_eq_, 0.0);
+      const KnownPoint& c = known_[centre_];
+      if (sao_.correction && c.ok) {
+        const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n_);
+        models.f_offset = c.f - models.fm->value(zero);
+        for (std::size_t i = 0; i < m_ineq_; ++i) models.g_offset[i] = c.g[i] - models.gm[i]->value(zero);
+        for (std::size_t j = 0; j < m_eq_; ++j) models.h_offset[j] = c.h[j] - models.hm[j]->value(zero);
+      }
       return models;
     } catch (const std::exception&) {
       continue;  // rank-deficient or too few points: a simpler basis
@@ -649,7 +676,7 @@ Eigen::VectorXd SaoRun::solve_subproblem(const Models& models, bool& feasibility
   for (const auto& st : starts) {
     const Eigen::VectorXd s = run_nlopt(models, false, st, lo, hi);
     if (models.max_violation(s) > std::max(tol, 1e-12)) continue;
-    const double f = models.f->value(s);
+    const double f = models.f(s);
     if (f < best_f) {
       best_f = f;
       best_s = s;
@@ -687,11 +714,12 @@ void SaoRun::update_penalty(const Models& models, const Eigen::VectorXd& s) {
   for (int i = 0; i < n_; ++i)
     if (s[i] > lo[i] + 1e-7 && s[i] < hi[i] - 1e-7) free.push_back(i);
   std::vector<Eigen::VectorXd> grads;
-  for (const auto& g : models.g)
-    if (g->value(s) >= -1e-6 * std::max(1.0, std::fabs(g->value(Eigen::VectorXd::Zero(n_))))) grads.push_back(g->gradient(s));
-  for (const auto& h : models.h) grads.push_back(h->gradient(s));
+  for (std::size_t i = 0; i < models.n_g(); ++i)
+    if (models.g(i, s) >= -1e-6 * std::max(1.0, std::fabs(models.g(i, Eigen::VectorXd::Zero(n_)))))
+      grads.push_back(models.g_grad(i, s));
+  for (std::size_t j = 0; j < models.n_h(); ++j) grads.push_back(models.h_grad(j, s));
   if (free.empty() || grads.empty()) return;
-  const Eigen::VectorXd gf = models.f->gradient(s);
+  const Eigen::VectorXd gf = models.f_grad(s);
   Eigen::MatrixXd A(free.size(), grads.size());
   Eigen::VectorXd b(free.size());
   for (std::size_t r = 0; r < free.size(); ++r) {
@@ -751,11 +779,11 @@ void SaoRun::run(const std::vector<double>& x0) {
 
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n_);
     auto predicted_merit = [&](const Eigen::VectorXd& x) {
-      return phase1 ? models->l1(x) : models->f->value(x) + mu_ * models->l1(x);
+      return phase1 ? models->l1(x) : models->f(x) + mu_ * models->l1(x);
     };
     if (!phase1 && models->l1(zero) > 0) {
       // the step must reduce the predicted merit: mu >= 2 (f^(s) - f^(0)) / V^(0)
-      const double df = models->f->value(s) - models->f->value(zero);
+      const double df = models->f(s) - models->f(zero);
       if (df > 0) mu_ = std::max(mu_, 2 * df / models->l1(zero));
     }
     const double predicted = predicted_merit(zero) - predicted_merit(s);
@@ -773,15 +801,21 @@ void SaoRun::run(const std::vector<double>& x0) {
     const double actual = phi_c - phi_x;
     const double rho = actual / predicted;
     const bool on_boundary = step >= 1 - 1e-3;
+    const double old_radius = radius_;
     if (!(actual > 0)) {
       radius_ *= sao_.shrink_factor;  // rejected: keep the centre
     } else {
       if (rho <= sao_.rho_shrink) radius_ *= sao_.shrink_factor;
       else if (rho >= sao_.rho_expand_low && rho <= sao_.rho_expand_high && on_boundary)
         radius_ = std::min(sao_.max_radius, radius_ * sao_.expand_factor);
+      else if (step < sao_.short_step) radius_ *= sao_.shrink_factor;
       centre_ = *cand;
       centre_z_ = known_[centre_].z;
     }
+    if (std::getenv("ABUOPT_SAO_TRACE"))
+      std::fprintf(stderr, "it %ld evals %ld basis %s phase1 %d r %.3g->%.3g rho %.3g pred %.3g act %.3g mu %.3g step %.3f fc %.8g\n",
+                   iterations, driver_.evaluations(), models->basis.c_str(), phase1 ? 1 : 0, old_radius, radius_, rho,
+                   predicted, actual, mu_, step, known_[centre_].f);
     const bool progress = actual > sao_.stall_tolerance * std::max(1.0, std::fabs(phi_c));
     stalled = progress ? 0 : stalled + 1;
   }

@@ -29,7 +29,8 @@
 //   6. Ratio test (Dakota): rho = (phi(c) - phi(x*)) / (phi^(c) - phi^(x*)).
 //      rho <= 0: reject, keep the centre, r *= shrink_factor.
 //      0 < rho <= 0.25: accept, r *= shrink_factor.   0.75 <= rho <= 1.25 and the step on the
-//      boundary of R: accept, r *= expand_factor (up to max_radius). Otherwise accept, keep r.
+//      boundary of R: accept, r *= expand_factor (up to max_radius). Otherwise accept, keep r,
+//      except that an accepted step shorter than short_step * r shrinks r (see short_step).
 // Stops (best point so far always returned, as minimize() does):
 //   r < min_radius (converged_xtol); the centre's merit improved by less than
 //   stall_tolerance * max(1, |phi|) for stall_iterations iterations (converged_ftol);
@@ -44,10 +45,11 @@
 #include <vector>
 
 #include "abuopt/common/yaml_reader.hpp"
-#include "abuopt/optimizer/evaluation_archive.hpp"
 #include "abuopt/optimizer/minimize.hpp"
 
 namespace abuopt::opt {
+
+class EvaluationArchive;  // evaluation_archive.hpp
 
 struct SaoOptions {
   // Surrogate of the objective and of every constraint: auto, linear, interactions,
@@ -78,6 +80,14 @@ struct SaoOptions {
   double rho_shrink = 0.25;      // rho <= rho_shrink: shrink (rho <= 0: also reject)
   double rho_expand_low = 0.75;  // rho in [rho_expand_low, rho_expand_high] and the step on
   double rho_expand_high = 1.25; // the boundary: expand
+
+  // Zeroth-order additive correction (Dakota's `correction additive zeroth_order`): every
+  // surrogate is shifted to match the true value at the centre.
+  bool correction = true;
+  // An accepted step shorter than short_step * r (infinity norm) also shrinks the region by
+  // shrink_factor: the surrogates say the optimum is near, and a smaller region refines them
+  // (without it a biased model creeps in ever smaller steps with rho ~ 1). 0: off. In [0, 1).
+  double short_step = 0.1;
 
   // Initial exact-penalty weight mu; 0: automatic, 10 max(1, |f(x0)|).
   double penalty_initial = 0.0;
