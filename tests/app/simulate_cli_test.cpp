@@ -1,0 +1,104 @@
+// `abuopt simulate` end to end on the built binary: JSON keys, and one message per class of bad
+// input (exit status 2, key path + value + rule, never a stack trace).
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace {
+
+struct Result {
+  int status;
+  std::string output;  // stdout + stderr
+};
+
+Result run(const std::string& args) {
+  const std::string cmd = std::string(ABUOPT_EXE) + " " + args + " 2>&1";
+  std::array<char, 4096> buf{};
+  std::string out;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return {-1, ""};
+  while (fgets(buf.data(), buf.size(), p)) out += buf.data();
+  const int st = pclose(p);
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+}
+
+std::string write_config(const std::string& name, const std::string& text) {
+  const std::string path = std::string(ABUOPT_BINARY_DIR) + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+const std::string kConfigs = std::string(ABUOPT_SOURCE_DIR) + "/configs/";
+
+}  // namespace
+
+TEST(SimulateCli, JsonHasTheDocumentedKeys) {
+  const Result r = run("simulate " + kConfigs + "report_final_profile.yaml --beta0 0.5,3.0 --json");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  for (const char* k : {"beta_final", "residual_imbalance", "residual_imbalance_x", "settled", "settling_time",
+                        "max_amplitude_mm", "status", "rhs_evaluations", "events"})
+    EXPECT_TRUE(j.contains(k)) << k;
+  EXPECT_EQ(j["status"], "ok");
+  EXPECT_EQ(j["beta_final"].size(), 2u);
+  EXPECT_LE(j["residual_imbalance_x"].get<double>(), j["residual_imbalance"].get<double>());
+}
+
+TEST(SimulateCli, ShippedConfigsRunAndTrajectoryIsWritten) {
+  const std::string csv = std::string(ABUOPT_BINARY_DIR) + "/traj_test.csv";
+  const Result r = run("simulate " + kConfigs + "one_step_100hz.yaml --trajectory " + csv + " --trajectory-interval 0.5");
+  ASSERT_EQ(r.status, 0) << r.output;
+  std::ifstream f(csv);
+  std::string header;
+  std::getline(f, header);
+  EXPECT_EQ(header, "t_s,frequency_hz,x_m,y_m,beta1_rad,beta2_rad,mode1,mode2");
+  int lines = 0;
+  for (std::string l; std::getline(f, l);) ++lines;
+  EXPECT_EQ(lines, 77);  // t = 0, 0.5, ..., 38 s
+}
+
+TEST(SimulateCli, BadInputGivesOneClearMessageAndStatus2) {
+  struct Case {
+    std::string yaml, extra, message;
+  };
+  const Case cases[] = {
+      {"abu: {frition_mu: 0.02}\n", "", "abu.frition_mu = 0.02: unknown key (misspelt, or not valid here)"},
+      {"abu: {friction_mu: lots}\n", "", "abu.friction_mu = lots: must be a number"},
+      {"abu: {friction_mu: 1.5}\n", "", "abu.friction_mu = 1.5: must be in [0, 0.999]"},
+      {"profile: {segments: [{end_frequency_hz: 25, duration_s: -2}]}\n", "",
+       "profile.segments[0].duration_s = -2: must be > 0"},
+      {"profile: {segments: []}\n", "", "profile.segments = []: must have at least one segment"},
+      {"simulation: {method: magic}\n", "", "simulation.method = magic: must be one of: event_driven, switch_model"},
+      {"abu: {balls: [{mass_kg: 1e-4, diameter_m: 0.02}]}\n", "",
+       "abu.balls[0].diameter_m = 0.02: must be smaller than abu.ball_track_radius_m (0.0115)"},
+      {"simulation: {rtol: 1e-6}\n", "--beta0 1,2,3", "--beta0 = 1,2,3: must give 2 angles (one per ball)"},
+      {"{}\n", "--beta0 1,x", "--beta0 = 1,x: must be a comma-separated list of angles in rad"},
+  };
+  int k = 0;
+  for (const auto& c : cases) {
+    const std::string path = write_config("bad_" + std::to_string(k++) + ".yaml", c.yaml);
+    const Result r = run("simulate " + path + " " + c.extra);
+    EXPECT_EQ(r.status, 2) << c.yaml << r.output;
+    EXPECT_EQ(r.output, "abuopt: error: " + c.message + "\n") << c.yaml;
+  }
+  const Result missing = run("simulate /nonexistent/none.yaml");
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_EQ(missing.output, "abuopt: error: config file '/nonexistent/none.yaml' cannot be opened (missing or unreadable)\n");
+  const Result notyaml = run("simulate " + write_config("bad_syntax.yaml", "abu: [1, 2\n"));
+  EXPECT_EQ(notyaml.status, 2);
+  EXPECT_NE(notyaml.output.find("is not valid YAML: line"), std::string::npos) << notyaml.output;
+}
+
+TEST(SimulateCli, HelpExplainsTheCommand) {
+  const Result r = run("simulate --help");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.output.find("--beta0"), std::string::npos);
+  EXPECT_NE(r.output.find("--trajectory"), std::string::npos);
+  EXPECT_NE(r.output.find("--json"), std::string::npos);
+}
