@@ -35,6 +35,17 @@ ErkStepper::ErkStepper(ButcherTable table, std::size_t n, RhsFn f, RootFn g, std
     : tab_(std::move(table)), n_(n), nroots_(nroots), f_(f), g_(g), user_(user), rtol_(rtol), atol_(atol),
       max_steps_(max_steps) {
   const std::size_t s = static_cast<std::size_t>(tab_.stages);
+  a_terms_.resize(s);
+  for (int i = 0; i < tab_.stages; ++i)
+    for (int j = 0; j < i; ++j) {
+      const double a = tab_.A[static_cast<std::size_t>(i * tab_.stages + j)];
+      if (a != 0.0) a_terms_[static_cast<std::size_t>(i)].push_back({j, a});
+    }
+  for (int j = 0; j < tab_.stages; ++j) {
+    const double b = tab_.b[static_cast<std::size_t>(j)], e = b - tab_.d[static_cast<std::size_t>(j)];
+    if (b != 0.0) b_terms_.push_back({j, b});
+    if (e != 0.0) e_terms_.push_back({j, e});
+  }
   y_.resize(n);
   f0_.resize(n);
   yprev_.resize(n);
@@ -79,26 +90,31 @@ double ErkStepper::attempt(double t0, const double* y0, const double* f0, double
   const int s = tab_.stages;
   std::copy(f0, f0 + n_, k_.begin());  // c_0 = 0 for every explicit table
   for (int i = 1; i < s; ++i) {
-    for (std::size_t m = 0; m < n_; ++m) {
-      double acc = 0;
-      for (int j = 0; j < i; ++j) acc += tab_.A[static_cast<std::size_t>(i * s + j)] * k_[static_cast<std::size_t>(j) * n_ + m];
-      tmp_[m] = y0[m] + h * acc;
+    std::copy(y0, y0 + n_, tmp_.begin());
+    for (const Term& a : a_terms_[static_cast<std::size_t>(i)]) {
+      const double ha = h * a.coef;
+      const double* k = &k_[static_cast<std::size_t>(a.stage) * n_];
+      for (std::size_t m = 0; m < n_; ++m) tmp_[m] += ha * k[m];
     }
     f_(t0 + tab_.c[static_cast<std::size_t>(i)] * h, tmp_.data(), &k_[static_cast<std::size_t>(i) * n_], user_);
     ++nf_;
   }
+  std::copy(y0, y0 + n_, yout);
+  std::fill(err_.begin(), err_.end(), 0.0);
+  for (const Term& b : b_terms_) {
+    const double hb = h * b.coef;
+    const double* k = &k_[static_cast<std::size_t>(b.stage) * n_];
+    for (std::size_t m = 0; m < n_; ++m) yout[m] += hb * k[m];
+  }
+  for (const Term& e : e_terms_) {
+    const double he = h * e.coef;
+    const double* k = &k_[static_cast<std::size_t>(e.stage) * n_];
+    for (std::size_t m = 0; m < n_; ++m) err_[m] += he * k[m];
+  }
   double norm = 0;
   for (std::size_t m = 0; m < n_; ++m) {
-    double hi = 0, lo = 0;
-    for (int j = 0; j < s; ++j) {
-      const double kj = k_[static_cast<std::size_t>(j) * n_ + m];
-      hi += tab_.b[static_cast<std::size_t>(j)] * kj;
-      lo += tab_.d[static_cast<std::size_t>(j)] * kj;
-    }
-    yout[m] = y0[m] + h * hi;
-    const double e = h * (hi - lo);
     const double sc = atol_ + rtol_ * std::max(std::fabs(y0[m]), std::fabs(yout[m]));
-    norm += (e / sc) * (e / sc);
+    norm += (err_[m] / sc) * (err_[m] / sc);
   }
   return std::sqrt(norm / static_cast<double>(n_));
 }

@@ -55,6 +55,13 @@ class ErkStepper {
   double initial_step() ;
 
   ButcherTable tab_;
+  // Nonzero entries only (Fehlberg 7(8) has 41 of 78 in A, 5 of 13 in b, 3 of 13 in b - d).
+  struct Term {
+    int stage;
+    double coef;
+  };
+  std::vector<std::vector<Term>> a_terms_;  // per stage
+  std::vector<Term> b_terms_, e_terms_;     // solution weights, error weights (b - d)
   std::size_t n_, nroots_;
   RhsFn f_;
   RootFn g_;
