@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "abuopt 0.1.0");
   abuopt::app::register_simulate(app);
   abuopt::app::register_montecarlo(app);
+  abuopt::app::register_eqset(app);
 
   try {
     app.parse(argc, argv);

@@ -11,5 +11,6 @@ int exit_code();
 
 void register_simulate(CLI::App& app);
 void register_montecarlo(CLI::App& app);
+void register_eqset(CLI::App& app);
 
 }  // namespace abuopt::app

@@ -1,0 +1,316 @@
+// abuopt eqset CONFIG --freq HZ | --scan FROM:TO:STEP: the equilibrium set at constant speed
+// (report fig 4.3): where all balls can stay stuck, the steady amplitude there, and the band of
+// speeds around resonance where the set does not cover the whole (beta_1, beta_2) plane.
+// Derivation and usage: docs/equilibrium_sets.md.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "abuopt/common/config_error.hpp"
+#include "abuopt/common/gnuplot.hpp"
+#include "abuopt/core/equilibrium_set.hpp"
+#include "abuopt/core/simulation_config.hpp"
+#include "commands/commands.hpp"
+
+namespace abuopt::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr long kMaxGrid = 4096;
+constexpr std::size_t kMaxScanPoints = 100000;
+
+struct EqsetArgs {
+  std::string config;
+  std::optional<double> freq, mu;
+  std::optional<std::string> scan;
+  std::optional<long> grid;
+  std::string out;
+  bool json = false;
+};
+
+// The optional `eqset` section of the config; command-line options override it.
+struct EqsetConfig {
+  std::optional<double> frequency_hz;
+  std::optional<std::vector<double>> scan_hz;  // from, to, step
+  std::optional<long> grid;
+  std::vector<double> other_angles_rad;        // balls 3..N
+};
+
+struct Scan {
+  double from = 0, to = 0, step = 0;
+};
+
+std::string num_text(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+
+void check_scan(const Scan& s, const std::string& option, const std::string& text) {
+  const std::string rule = "must be FROM:TO:STEP in Hz with 0 < FROM <= TO and STEP > 0";
+  if (!(std::isfinite(s.from) && std::isfinite(s.to) && std::isfinite(s.step)) || !(s.from > 0) ||
+      !(s.to >= s.from) || !(s.step > 0))
+    throw ConfigError(option, text, rule);
+  if ((s.to - s.from) / s.step + 1 > static_cast<double>(kMaxScanPoints))
+    throw ConfigError(option, text, "must give at most " + std::to_string(kMaxScanPoints) + " frequencies");
+}
+
+Scan parse_scan(const std::string& text) {
+  std::vector<double> v;
+  std::stringstream ss(text);
+  std::string item;
+  const std::string rule = "must be FROM:TO:STEP in Hz with 0 < FROM <= TO and STEP > 0";
+  while (std::getline(ss, item, ':')) {
+    try {
+      std::size_t used = 0;
+      v.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw ConfigError("--scan", text, rule);
+    }
+  }
+  if (v.size() != 3 || text.back() == ':') throw ConfigError("--scan", text, rule);
+  Scan s{v[0], v[1], v[2]};
+  check_scan(s, "--scan", text);
+  return s;
+}
+
+EqsetConfig read_eqset_section(YamlReader r) {
+  EqsetConfig c;
+  if (!r.present()) return c;
+  if (r.has("frequency_hz")) c.frequency_hz = r.get_double("frequency_hz", Rule::positive());
+  if (r.has("grid")) c.grid = r.get_int("grid", Rule::in_range(2, kMaxGrid));
+  if (r.has("scan_hz")) {
+    auto v = r.get_double_list("scan_hz");
+    std::ostringstream text;
+    text << "[";
+    for (std::size_t k = 0; k < v.size(); ++k) text << (k ? ", " : "") << v[k];
+    text << "]";
+    if (v.size() != 3) throw ConfigError(r.key_path("scan_hz"), text.str(), "must be [from, to, step] in Hz");
+    check_scan(Scan{v[0], v[1], v[2]}, r.key_path("scan_hz"), text.str());
+    c.scan_hz = v;
+  }
+  if (r.has("other_angles_rad")) c.other_angles_rad = r.get_double_list("other_angles_rad");
+  r.finish();
+  return c;
+}
+
+nlohmann::json band_json(const std::optional<std::pair<double, double>>& b) {
+  if (!b) return nullptr;
+  return nlohmann::json::array({b->first, b->second});
+}
+
+fs::path make_out_dir(const std::string& dir, const std::string& option) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) throw ConfigError(option, dir, "must be a directory that can be created and written");
+  return fs::path(dir);
+}
+
+int run_single(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig& cfg, double freq, std::size_t n) {
+  const EquilibriumGrid g = set.grid(freq, n, cfg.other_angles_rad);
+  const std::size_t nb = g.n_balls;
+  const fs::path dir = make_out_dir(a.out.empty() ? "results/eqset-" + num_text(freq) + "Hz" : a.out, "--out");
+  const fs::path csv = dir / "equilibrium_set.csv";
+  {
+    std::ofstream f(csv);
+    if (!f) throw ConfigError("--out", dir.string(), "must be writable (" + csv.string() + ")");
+    f << "beta1_rad,beta2_rad,amplitude_mm,in_set";
+    for (std::size_t b = 0; b < nb; ++b) f << ",margin_" << b + 1;
+    f << "\n" << std::setprecision(10);
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t j = 0; j < n; ++j) {
+        const std::size_t k = g.index(i, j);
+        f << g.beta(i) << "," << g.beta(j) << "," << g.amplitude_mm[k] << "," << int(g.in_set[k]);
+        for (std::size_t b = 0; b < nb; ++b) f << "," << g.margins[k * nb + b];
+        f << "\n";
+      }
+  }
+  double in_min = INFINITY, in_max = -INFINITY;
+  for (std::size_t k = 0; k < n * n; ++k)
+    if (g.in_set[k]) {
+      in_min = std::min(in_min, g.amplitude_mm[k]);
+      in_max = std::max(in_max, g.amplitude_mm[k]);
+    }
+
+  GridPlot plot;
+  plot.csv_path = csv.string();
+  plot.png_path = (dir / "equilibrium_set.png").string();
+  plot.width_px = 820;
+  plot.height_px = 760;
+  std::ostringstream title;
+  title << "equilibrium set at " << freq << " Hz (W = " << std::setprecision(4) << set.speed_ratio(freq)
+        << ", mu = " << set.mu() << "): coverage " << std::setprecision(3) << g.coverage();
+  plot.labels = {title.str(), "beta_1 [rad]", "beta_2 [rad]"};
+  plot.fill_column = 4;
+  plot.palette = "defined (0 '#f4cccc', 1 '#b6d7a8')";
+  plot.cb_min = 0;
+  plot.cb_max = 1;
+  plot.cb_tics = "('outside' 0, 'in set' 1)";
+  plot.contour_column = 3;
+  plot.contour_levels = 8;
+  plot.contour_title = "steady amplitude [mm]";
+  const PlotStatus ps = Gnuplot().grid(plot);
+
+  if (a.json) {
+    nlohmann::json j;
+    j["frequency_hz"] = freq;
+    j["speed_ratio"] = set.speed_ratio(freq);
+    j["natural_frequency_hz"] = set.natural_frequency_hz();
+    j["mu"] = set.mu();
+    j["grid"] = n;
+    j["coverage"] = g.coverage();
+    j["full_coverage_closed_form"] = set.full_coverage_margin(freq) >= 0;
+    j["amplitude_mm"] = {{"min", g.min_amplitude_mm()}, {"max", g.max_amplitude_mm()}};
+    if (in_min <= in_max)
+      j["amplitude_in_set_mm"] = {{"min", in_min}, {"max", in_max}};
+    else
+      j["amplitude_in_set_mm"] = nullptr;
+    j["csv"] = csv.string();
+    j["png"] = plot.png_path;
+    j["plot"] = {{"status", to_string(ps.state)}, {"message", ps.message}, {"script", ps.script_path}};
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << std::setprecision(6);
+    std::cout << "frequency:         " << freq << " Hz (W = " << set.speed_ratio(freq) << ", natural frequency "
+              << set.natural_frequency_hz() << " Hz), mu = " << set.mu() << "\n";
+    std::cout << "coverage:          " << g.coverage() << " of the " << n << " x " << n << " grid over (beta_1, beta_2)"
+              << (set.full_coverage_margin(freq) >= 0 ? " (closed form: the whole plane)" : "") << "\n";
+    std::cout << "amplitude [mm]:    " << g.min_amplitude_mm() << " .. " << g.max_amplitude_mm() << " (all points)";
+    if (in_min <= in_max) std::cout << ", " << in_min << " .. " << in_max << " (in the set)";
+    std::cout << "\ncsv:               " << csv.string() << "\n";
+    std::cout << "plot:              " << (ps.ran() ? plot.png_path : ps.message) << "\n";
+  }
+  return 0;
+}
+
+int run_scan(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig& cfg, const Scan& sc, std::size_t n) {
+  const EquilibriumScan s = set.scan(sc.from, sc.to, sc.step, n, cfg.other_angles_rad);
+  const auto exact = sc.to > sc.from ? set.exact_band_hz(sc.from, sc.to) : std::nullopt;
+  std::string csv_path, plot_text;
+  PlotStatus ps;
+  if (!a.out.empty()) {
+    const fs::path dir = make_out_dir(a.out, "--out");
+    csv_path = (dir / "coverage.csv").string();
+    std::ofstream f(csv_path);
+    if (!f) throw ConfigError("--out", dir.string(), "must be writable (" + csv_path + ")");
+    f << "frequency_hz,coverage\n" << std::setprecision(10);
+    for (std::size_t k = 0; k < s.frequency_hz.size(); ++k) f << s.frequency_hz[k] << "," << s.coverage[k] << "\n";
+    f.close();
+    XYLinesPlot plot;
+    plot.csv_path = csv_path;
+    plot.png_path = (dir / "coverage.png").string();
+    std::ostringstream title;
+    title << "equilibrium-set coverage (mu = " << set.mu() << ", natural frequency " << std::setprecision(4)
+          << set.natural_frequency_hz() << " Hz)";
+    plot.labels = {title.str(), "frequency [Hz]", "fraction of the (beta_1, beta_2) plane"};
+    plot.series = {{1, 2, "coverage", "linespoints"}};
+    ps = Gnuplot().xy_lines(plot);
+    plot_text = ps.ran() ? plot.png_path : ps.message;
+  }
+  if (a.json) {
+    nlohmann::json j;
+    j["mu"] = s.mu;
+    j["grid"] = s.grid_n;
+    j["natural_frequency_hz"] = s.natural_frequency_hz;
+    j["band_hz"] = band_json(s.band_hz);
+    j["exact_band_hz"] = band_json(exact);
+    nlohmann::json cov = nlohmann::json::array();
+    for (std::size_t k = 0; k < s.frequency_hz.size(); ++k)
+      cov.push_back({{"frequency_hz", s.frequency_hz[k]}, {"coverage", s.coverage[k]}});
+    j["coverage"] = cov;
+    if (!csv_path.empty()) {
+      j["csv"] = csv_path;
+      j["plot"] = {{"status", to_string(ps.state)}, {"message", ps.message}, {"script", ps.script_path}};
+    }
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << std::setprecision(6);
+    std::cout << "# equilibrium-set coverage, mu = " << s.mu << ", " << n << " x " << n << " grid\n";
+    std::cout << "# frequency_hz coverage\n";
+    for (std::size_t k = 0; k < s.frequency_hz.size(); ++k)
+      std::cout << std::setw(12) << s.frequency_hz[k] << " " << s.coverage[k] << "\n";
+    std::cout << "natural frequency: " << s.natural_frequency_hz << " Hz\n";
+    if (s.band_hz)
+      std::cout << "band (coverage < 1 on the grid): " << s.band_hz->first << " .. " << s.band_hz->second << " Hz\n";
+    else
+      std::cout << "band (coverage < 1 on the grid): none in " << sc.from << " .. " << sc.to << " Hz\n";
+    if (exact)
+      std::cout << "band (closed form, continuous plane): " << exact->first << " .. " << exact->second << " Hz\n";
+    if (!csv_path.empty()) std::cout << "csv: " << csv_path << "\nplot: " << plot_text << "\n";
+  }
+  return 0;
+}
+
+int run_eqset(const EqsetArgs& a) {
+  // Option values first: a bad option is reported before the config is read.
+  if (a.freq && !(std::isfinite(*a.freq) && *a.freq > 0))
+    throw ConfigError("--freq", num_text(*a.freq), "must be a frequency > 0 Hz");
+  if (a.grid && (*a.grid < 2 || *a.grid > kMaxGrid))
+    throw ConfigError("--grid", std::to_string(*a.grid), "must be in [2, " + std::to_string(kMaxGrid) + "] (points per axis)");
+  if (a.mu && !(std::isfinite(*a.mu) && *a.mu >= 0 && *a.mu < 1))
+    throw ConfigError("--mu", num_text(*a.mu), "must be in [0, 1) (a friction coefficient)");
+  std::optional<Scan> scan;
+  if (a.scan) scan = parse_scan(*a.scan);
+
+  YamlReader root = YamlReader::load_file(a.config);
+  const SimulationSetup setup = read_simulation_setup(root);
+  const EqsetConfig cfg = read_eqset_section(root.child("eqset"));
+  root.finish();
+  const std::size_t nb = setup.abu.balls.size();
+  if (nb < 2) throw ConfigError("abu.balls", std::to_string(nb) + " balls", "the equilibrium-set grid needs at least 2 balls");
+  if (cfg.other_angles_rad.size() != nb - 2)
+    throw ConfigError("eqset.other_angles_rad", std::to_string(cfg.other_angles_rad.size()) + " angles",
+                      "must give the fixed angles of balls 3.." + std::to_string(nb) + " (" + std::to_string(nb - 2) +
+                          " values)");
+
+  const EquilibriumSet set(setup.abu, a.mu ? *a.mu : -1.0);
+  if (!a.freq && !scan) {
+    if (cfg.frequency_hz) {
+      const auto n = static_cast<std::size_t>(a.grid ? *a.grid : cfg.grid.value_or(128));
+      return run_single(a, set, cfg, *cfg.frequency_hz, n);
+    }
+    if (cfg.scan_hz) {
+      const auto& v = *cfg.scan_hz;
+      const auto n = static_cast<std::size_t>(a.grid ? *a.grid : cfg.grid.value_or(64));
+      return run_scan(a, set, cfg, Scan{v[0], v[1], v[2]}, n);
+    }
+    throw ConfigError("--freq", "<missing>", "give --freq HZ or --scan FROM:TO:STEP (or eqset.frequency_hz / eqset.scan_hz in the config)");
+  }
+  if (scan) return run_scan(a, set, cfg, *scan, static_cast<std::size_t>(a.grid ? *a.grid : cfg.grid.value_or(64)));
+  return run_single(a, set, cfg, *a.freq, static_cast<std::size_t>(a.grid ? *a.grid : cfg.grid.value_or(128)));
+}
+
+}  // namespace
+
+void register_eqset(CLI::App& app) {
+  auto args = std::make_shared<EqsetArgs>();
+  CLI::App* sub = app.add_subcommand(
+      "eqset",
+      "Equilibrium set at constant speed (report fig 4.3): the ball angles (beta_1, beta_2) where all balls\n"
+      "can stay stuck, with the steady vibration amplitude there.\n"
+      "  --freq HZ: writes DIR/equilibrium_set.csv and .png (set and amplitude contours); prints coverage\n"
+      "  --scan FROM:TO:STEP: prints the coverage per frequency and the band where it is below 1.\n"
+      "Exit status: 0 ok, 2 bad input.");
+  sub->add_option("config", args->config, "YAML config (section abu; optional section eqset)")->required();
+  auto* freq = sub->add_option("--freq", args->freq, "constant speed in Hz (> 0)");
+  auto* scan = sub->add_option("--scan", args->scan, "frequency scan FROM:TO:STEP in Hz, e.g. 10:50:0.5");
+  freq->excludes(scan);
+  sub->add_option("--grid", args->grid, "points per axis of the (beta_1, beta_2) grid, >= 2 (default 128; scan 64)");
+  sub->add_option("--mu", args->mu, "override the friction coefficient abu.friction_mu, in [0, 1)");
+  sub->add_option("--out", args->out,
+                  "output directory (default for --freq: results/eqset-<freq>Hz; --scan writes files only when given)");
+  sub->add_flag("--json", args->json, "print the result as one JSON object");
+  sub->callback([args] { set_exit_code(run_eqset(*args)); });
+}
+
+}  // namespace abuopt::app
