@@ -217,7 +217,7 @@ std::string Gnuplot::grid_body(const GridPlot& p, const std::string& grid_data_p
   labels_lines(s, p.labels);
   s << "set view map\n";
   if (p.square) s << "set size square\n";
-  s << "set autoscale fix\nset tics out\nset key below\n";
+  s << "set autoscale fix\nset tics out\nset key at screen 0.5, 0.03 center horizontal\nset bmargin 5\n";
   if (!p.palette.empty()) s << "set palette " << p.palette << "\n";
   if (p.cb_max > p.cb_min) s << "set cbrange [" << p.cb_min << ":" << p.cb_max << "]\n";
   if (!p.cb_tics.empty()) s << "set cbtics " << p.cb_tics << "\n";
