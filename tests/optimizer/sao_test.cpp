@@ -7,10 +7,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <functional>
+#include <limits>
 #include <iostream>
 #include <string>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/optimizer/evaluation_archive.hpp"
 #include "abuopt/optimizer/minimize.hpp"
 #include "abuopt/optimizer/sao.hpp"
 #include "abuopt/problems/benchmarks/benchmark_factory.hpp"
@@ -37,6 +41,7 @@ struct Case {
   long budget;
   double f_tol;               // |f - f*| <= f_tol * max(1, |f*|), f noise-free
   double constraint_tol = 1e-6;
+  bool noisy_settings = false;  // doe_points = 2 (2n + 1): least squares over twice the terms
 };
 
 std::string case_name(const testing::TestParamInfo<Case>& info) { return info.param.problem; }
@@ -51,6 +56,7 @@ TEST_P(SaoConvergence, ReachesBestKnown) {
   o.max_evaluations = c.budget;
   o.constraint_tolerance = c.constraint_tol;
   opt::SaoOptions sao;
+  if (c.noisy_settings) sao.doe_points = 2 * (2 * static_cast<int>(problem->dimension()) + 1);
   const opt::OptimizationResult r = opt::minimize_sao(*problem, o, sao);
   std::cout << "[measure] " << c.problem << ": " << r.brief_report()
             << "; evaluations to 1%: " << evaluations_to_one_percent(r, best.objective) << "\n";
@@ -69,10 +75,229 @@ INSTANTIATE_TEST_SUITE_P(Smooth, SaoConvergence,
                                          Case{"cantilever", 300, kTight}, Case{"two_bar_truss", 200, kTight}),
                          case_name);
 INSTANTIATE_TEST_SUITE_P(Noisy, SaoConvergence,
-                         testing::Values(Case{"noisy_rosenbrock", 400, kLoose},
-                                         Case{"noisy_hs071", 300, kLoose, 1e-2},
-                                         Case{"noisy_cantilever", 300, kLoose, 1e-2},
-                                         Case{"noisy_two_bar_truss", 200, kLoose, 1e-2}),
+                         testing::Values(Case{"noisy_rosenbrock", 400, kLoose, 1e-6, true},
+                                         Case{"noisy_hs071", 400, kLoose, 1e-2, true},
+                                         Case{"noisy_cantilever", 400, kLoose, 1e-2, true},
+                                         Case{"noisy_two_bar_truss", 200, kLoose, 1e-2, true}),
                          case_name);
 
 }  // namespace
+
+// Evaluations to reach 1 % of best_known, SAO against COBYLA (both from the problem's starting
+// point, constraint tolerance 1e-6). Measured: two_bar_truss SAO 6 / COBYLA 12, hs071 34 / 74:
+// asserted; cantilever 82 / 27 (COBYLA's linear models suit its one nearly linear constraint
+// better): printed only.
+class SaoVersusCobyla : public testing::TestWithParam<std::string> {};
+
+TEST_P(SaoVersusCobyla, EvaluationsToOnePercent) {
+  const bool assert_fewer = GetParam() != "cantilever";
+  auto problem = problems::make_benchmark(GetParam());
+  const double f_star = problem->best_known()->objective;
+  opt::OptimizerOptions o;
+  o.max_evaluations = 1000;
+  const opt::OptimizationResult sao = opt::minimize_sao(*problem, o, opt::SaoOptions{});
+  o.algorithm = "COBYLA";
+  const opt::OptimizationResult cobyla = opt::minimize(*problem, o);
+  const long n_sao = evaluations_to_one_percent(sao, f_star);
+  const long n_cobyla = evaluations_to_one_percent(cobyla, f_star);
+  std::cout << "[measure] " << GetParam() << ": evaluations to 1%: SAO " << n_sao << ", COBYLA " << n_cobyla << "\n";
+  ASSERT_GT(n_sao, 0);
+  ASSERT_GT(n_cobyla, 0);
+  if (assert_fewer) {
+    EXPECT_LT(n_sao, n_cobyla);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Constrained, SaoVersusCobyla, testing::Values("cantilever", "two_bar_truss", "hs071"));
+
+// An infeasible start: the feasibility phase (minimise the predicted violation) leads to the
+// feasible region, then to the optimum.
+TEST(Sao, InfeasibleStartReachesFeasibleOptimum) {
+  struct Start {
+    std::string problem;
+    std::vector<double> x0;
+  };
+  for (const Start& st : {Start{"cantilever", {2, 2, 2, 2, 2}}, Start{"hs071", {1, 1, 1, 1}},
+                          Start{"two_bar_truss", {0.3, 1.5}}}) {
+    auto problem = problems::make_benchmark(st.problem);
+    const opt::Evaluation e0 = problem->evaluate(st.x0);
+    ASSERT_GT(opt::max_constraint_violation(e0), 0.1) << st.problem << ": the start must be infeasible";
+    opt::OptimizerOptions o;
+    o.max_evaluations = 400;
+    const opt::OptimizationResult r = opt::minimize_sao(*problem, o, opt::SaoOptions{}, st.x0);
+    const double f_star = problem->best_known()->objective;
+    std::cout << "[measure] infeasible start " << st.problem << ": " << r.brief_report() << "\n";
+    EXPECT_TRUE(r.success()) << r.full_report();
+    EXPECT_TRUE(r.feasible);
+    EXPECT_NEAR(r.objective, f_star, 1e-3 * std::max(1.0, std::fabs(f_star))) << r.full_report();
+    EXPECT_FALSE(r.history.front().feasible);
+  }
+}
+
+// Stopped by the evaluation budget: the best FEASIBLE point of the history is returned (not the
+// last iterate, not an infeasible point with a lower objective), and the run is not a success.
+TEST(Sao, BudgetStopReturnsBestFeasiblePoint) {
+  auto problem = problems::make_benchmark("cantilever");
+  opt::OptimizerOptions o;
+  o.max_evaluations = 30;
+  const opt::OptimizationResult r = opt::minimize_sao(*problem, o, opt::SaoOptions{});
+  EXPECT_EQ(r.reason, opt::TerminationReason::max_evaluations);
+  EXPECT_EQ(r.evaluations, 30);
+  EXPECT_FALSE(r.success());
+  ASSERT_TRUE(r.has_feasible_point());
+  double best = std::numeric_limits<double>::infinity();
+  bool some_infeasible_lower = false;
+  for (const auto& h : r.history) {
+    if (h.feasible) best = std::min(best, h.objective);
+  }
+  for (const auto& h : r.history)
+    if (!h.feasible && h.objective < best) some_infeasible_lower = true;
+  EXPECT_EQ(r.objective, best);
+  EXPECT_TRUE(some_infeasible_lower) << "the case should contain an infeasible point below the best feasible one";
+}
+
+// A failed evaluation (ok == false) never ends the run: the region shrinks away from it.
+TEST(Sao, FailedEvaluationsAreSurvived) {
+  opt::FunctionProblem p(
+      "bowl_with_hole", {{"a", -1, 1, 1}, {"b", -1, 1, 1}},
+      [](const std::vector<double>& x) {
+        if (x[0] > 0.35 && x[0] < 0.45) return opt::Evaluation::failed("simulation did not finish");
+        opt::Evaluation e;
+        e.objective = (x[0] - 0.5) * (x[0] - 0.5) + (x[1] + 0.2) * (x[1] + 0.2);
+        return e;
+      });
+  p.set_initial_point({-0.5, 0.5});
+  opt::OptimizerOptions o;
+  o.max_evaluations = 300;
+  const opt::OptimizationResult r = opt::minimize_sao(p, o, opt::SaoOptions{});
+  EXPECT_TRUE(r.success()) << r.full_report();
+  EXPECT_NEAR(r.x[0], 0.5, 1e-3);
+  EXPECT_NEAR(r.x[1], -0.2, 1e-3);
+}
+
+// The points of an attached archive inform the surrogates and are not evaluated again.
+TEST(Sao, ReusesArchivedPoints) {
+  auto problem = problems::make_benchmark("two_bar_truss");
+  const std::string path = std::string(ABUOPT_BINARY_DIR) + "/sao_test_archive.sqlite";
+  std::remove(path.c_str());
+  opt::OptimizerOptions o;
+  o.max_evaluations = 200;
+  long first = 0;
+  {
+    opt::EvaluationArchive archive(path, "truss");
+    opt::ArchivedProblem archived(*problem, archive);
+    opt::SaoOptions sao;
+    sao.archive = &archive;
+    const opt::OptimizationResult r = opt::minimize_sao(archived, o, sao);
+    first = r.evaluations;
+    EXPECT_EQ(archived.misses(), first);
+  }
+  opt::EvaluationArchive archive(path, "truss");
+  opt::ArchivedProblem archived(*problem, archive);
+  opt::SaoOptions sao;
+  sao.archive = &archive;
+  const opt::OptimizationResult r = opt::minimize_sao(archived, o, sao);
+  EXPECT_TRUE(r.success()) << r.full_report();
+  // the archived points cover the DOE of the rerun, which takes a slightly different path (its
+  // first surrogates already see every archived point) and needs only a few new evaluations
+  std::cout << "[measure] archive reuse: first run " << first << " evaluations, rerun " << archived.misses()
+            << " new ones\n";
+  EXPECT_LE(archived.misses(), first / 2);
+  std::remove(path.c_str());
+}
+
+// minimize_any dispatches "sao" (any case) to minimize_sao and everything else to minimize.
+TEST(Sao, MinimizeAnyDispatchesByName) {
+  auto problem = problems::make_benchmark("two_bar_truss");
+  opt::OptimizerOptions o;
+  o.algorithm = "Sao";
+  o.max_evaluations = 200;
+  EXPECT_EQ(opt::minimize_any(*problem, o).algorithm, "SAO(auto)");
+  o.algorithm = "cobyla";
+  EXPECT_EQ(opt::minimize_any(*problem, o).algorithm, "COBYLA");
+  EXPECT_TRUE(opt::is_sao_algorithm("SAO"));
+  EXPECT_FALSE(opt::is_sao_algorithm("SLSQP"));
+}
+
+// ---- options ----
+
+std::string config_error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "<no ConfigError>";
+}
+
+TEST(SaoOptions, DefaultsAreValid) { EXPECT_NO_THROW(opt::SaoOptions{}.validate()); }
+
+TEST(SaoOptions, BadValuesNameKeyValueAndRule) {
+  auto message = [](const std::function<void(opt::SaoOptions&)>& change) {
+    opt::SaoOptions s;
+    change(s);
+    return config_error_of([&] { s.validate(); });
+  };
+  EXPECT_EQ(message([](auto& s) { s.min_radius = 0; }), "sao.min_radius = 0: must be in (0, initial_radius = 0.1]");
+  EXPECT_EQ(message([](auto& s) { s.max_radius = 0.05; }),
+            "sao.max_radius = 0.05: must be in [initial_radius = 0.1, 1]");
+  EXPECT_EQ(message([](auto& s) { s.shrink_factor = 1.5; }), "sao.shrink_factor = 1.5: must be in (0, 1)");
+  EXPECT_EQ(message([](auto& s) { s.expand_factor = 0.5; }), "sao.expand_factor = 0.5: must be in [1, 100]");
+  EXPECT_EQ(message([](auto& s) { s.initial_radius = -1; }), "sao.initial_radius = -1: must be in (0, 1]");
+  EXPECT_EQ(message([](auto& s) { s.rho_expand_low = 0.2; }), "sao.rho_expand_low = 0.2: must be > rho_shrink = 0.25");
+  EXPECT_EQ(message([](auto& s) { s.stall_iterations = 0; }), "sao.stall_iterations = 0: must be >= 1");
+  EXPECT_EQ(message([](auto& s) { s.surrogate = "cubic"; }),
+            "sao.surrogate = cubic: must be one of: auto, linear, interactions, pure_quadratic, quadratic, kriging");
+  EXPECT_EQ(message([](auto& s) { s.doe = "sobol"; }),
+            "sao.doe = sobol: must be one of: auto, koshal, axial, central_composite, lhs");
+  EXPECT_EQ(message([](auto& s) { s.subproblem_solver = "ipopt"; }),
+            "sao.subproblem_solver = ipopt: must be one of: slsqp, cobyla");
+  EXPECT_EQ(message([](auto& s) {
+              s.surrogate = "quadratic";
+              s.doe = "koshal";
+            }),
+            "sao.doe = koshal: koshal (n+1 points) cannot determine a quadratic surrogate; use auto, axial, "
+            "central_composite or lhs");
+  EXPECT_EQ(message([](auto& s) { s.reuse_distance = 0; }), "sao.reuse_distance = 0: must be in (0, 1]");
+}
+
+TEST(SaoOptions, ReadFromYaml) {
+  YamlReader root = YamlReader::load_string(
+      "sao:\n  surrogate: quadratic\n  doe: lhs\n  initial_radius: 0.2\n  max_radius: 0.8\n  correction: false\n");
+  YamlReader section = root.child("sao");
+  const opt::SaoOptions s = opt::read_sao_options(section);
+  EXPECT_EQ(s.surrogate, "quadratic");
+  EXPECT_EQ(s.doe, "lhs");
+  EXPECT_DOUBLE_EQ(s.initial_radius, 0.2);
+  EXPECT_DOUBLE_EQ(s.max_radius, 0.8);
+  EXPECT_FALSE(s.correction);
+  EXPECT_DOUBLE_EQ(s.min_radius, opt::SaoOptions{}.min_radius);  // absent keys keep defaults
+
+  auto error_of = [](const std::string& text) {
+    return config_error_of([&] {
+      YamlReader r = YamlReader::load_string(text);
+      YamlReader sec = r.child("sao");
+      opt::read_sao_options(sec);
+    });
+  };
+  EXPECT_EQ(error_of("sao:\n  initial_radius: 0.2\n  min_radius: 0.3\n"),
+            "sao.min_radius = 0.3: must be in (0, initial_radius = 0.2]");
+  EXPECT_NE(error_of("sao:\n  radius: 0.2\n").find("sao.radius"), std::string::npos);  // unknown key
+  EXPECT_EQ(error_of("sao:\n  surrogate: cubic\n"),
+            "sao.surrogate = cubic: must be one of: auto, linear, interactions, pure_quadratic, quadratic, kriging");
+}
+
+// Every surrogate and DOE choice runs and reaches the truss optimum.
+TEST(Sao, EverySurrogateChoiceWorks) {
+  for (const std::string surrogate : {"linear", "interactions", "pure_quadratic", "quadratic", "kriging"}) {
+    auto problem = problems::make_benchmark("two_bar_truss");
+    opt::OptimizerOptions o;
+    o.max_evaluations = 300;
+    opt::SaoOptions sao;
+    sao.surrogate = surrogate;
+    const opt::OptimizationResult r = opt::minimize_sao(*problem, o, sao);
+    std::cout << "[measure] two_bar_truss " << surrogate << ": " << r.brief_report() << "\n";
+    ASSERT_TRUE(r.has_feasible_point()) << surrogate;
+    EXPECT_NEAR(r.objective, 1.5086524, 1e-2) << surrogate << "\n" << r.full_report();
+  }
+}
