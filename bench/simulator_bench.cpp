@@ -15,6 +15,7 @@ abuopt::SimulationSetup final_profile(abuopt::IntegratorBackend backend, double 
   abuopt::SimulationSetup s;  // defaults: report table 3.2, mu = 0.02, the report's final profile
   s.options.backend = backend;
   s.options.rtol = rtol;
+  s.options.atol = rtol * 1e-3;  // the default pair is rtol 1e-6, atol 1e-9
   return s;
 }
 
