@@ -1,0 +1,158 @@
+#pragma once
+// Comparison of optimisers on a set of problems (Moré & Wild 2009, "Benchmarking derivative-free
+// optimization algorithms"; Dolan & Moré 2002, "Benchmarking optimization software with
+// performance profiles").
+//
+//   ComparisonSetup setup;
+//   setup.problems.push_back({"hs071", [] { return make_benchmark("hs071"); }, 200, 3});
+//   setup.solvers.push_back(solver_spec("SAO", "sao"));
+//   setup.solvers.push_back(solver_spec("COBYLA", "cobyla"));
+//   ComparisonResult r = run_comparison(setup);
+//   std::cout << format_table(r);
+//   write_comparison(r, "results/compare-x");   // CSVs, gnuplot script, PNGs if gnuplot exists
+//
+// An *instance* is a (problem, starting point) pair; every solver runs on every instance with the
+// problem's evaluation budget, and every run keeps its history.
+//
+// Solved: instance p is solved by a run at the first evaluation that is feasible and has
+//   f - f* <= tau * max(|f*|, 1)
+// (f the true objective: the metric `true_objective_metric` when an evaluation reports it, as the
+// noisy benchmarks do, else the objective). t_{p,s} = that evaluation count (1-based), +inf if
+// never. f* = ProblemSpec::f_star, else the problem's best_known(), else the lowest feasible true
+// objective found by any run on that problem.
+//   data profile        d_s(alpha) = |{p : t_{p,s} <= alpha (n_p + 1)}| / |P|
+//   performance profile rho_s(tau) = |{p : r_{p,s} <= tau}| / |P|,
+//                       r_{p,s} = t_{p,s} / min_s' t_{p,s'}  (+inf if s did not solve p; if no
+//                       solver solved p, p counts in |P| but never as solved)
+// Problems from elsewhere (the startup-profile design problem built from its config) join
+// through the ProblemFactory callback.
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "abuopt/common/yaml_reader.hpp"
+#include "abuopt/optimizer/optimization_result.hpp"
+#include "abuopt/optimizer/optimizer_options.hpp"
+#include "abuopt/optimizer/problem.hpp"
+#include "abuopt/optimizer/sao.hpp"
+
+namespace abuopt::opt {
+
+// One optimiser of a comparison: any algorithm name of minimize() (NLopt names, IPOPT) or SAO.
+struct SolverSpec {
+  std::string label;         // its name in tables and plots (unique)
+  OptimizerOptions options;  // algorithm and settings; max_evaluations, constraint_tolerance and
+                             // seed are set per run from the ProblemSpec
+  SaoOptions sao;            // used when options.algorithm is "SAO"
+};
+// A solver with default settings; `algorithm` is checked (ConfigError listing the valid names).
+SolverSpec solver_spec(const std::string& label, const std::string& algorithm);
+// Reads one solver entry: label, algorithm (any minimize() name or sao), optional `options:`
+// (the keys of an optimizer: section except algorithm) and `sao:` sections.
+SolverSpec read_solver_spec(YamlReader& entry);
+
+// Makes a fresh instance of a problem (called once per run).
+using ProblemFactory = std::function<std::unique_ptr<Problem>()>;
+
+struct ProblemSpec {
+  std::string label;                   // unique
+  ProblemFactory make;
+  long max_evaluations = 200;          // budget of every run (> 0)
+  int starts = 1;                      // the problem's initial_point(), then starts-1 seeded
+                                       // uniform random points in the bounds (>= 1)
+  std::uint64_t seed = 1;              // of the random starts; run k of a solver gets seed + k
+  double constraint_tolerance = 1e-6;  // feasibility tolerance of every run on it
+  std::optional<double> f_star;        // reference value (else best_known(), else best found)
+};
+
+struct RunRecord;
+
+struct ComparisonSetup {
+  std::vector<ProblemSpec> problems;
+  std::vector<SolverSpec> solvers;
+  double tau = 1e-2;  // accuracy of "solved" (relative, see above), in (0, 1)
+  std::string true_objective_metric = "noise_free_objective";
+  // Called after each run (e.g. to print progress); may be empty.
+  std::function<void(const RunRecord&)> on_run;
+};
+
+// One point of a convergence curve: after `evaluation` evaluations the best feasible true
+// objective so far is `best` (recorded when it improves).
+struct ConvergencePoint {
+  long evaluation = 0;
+  double best = 0.0;
+};
+
+struct RunRecord {
+  std::string problem;
+  std::string solver;
+  int start = 0;                   // index of the starting point
+  std::size_t dimension = 0;       // n_p
+  std::vector<double> x0;
+  OptimizationResult result;       // with its history
+  double best_true_objective = std::numeric_limits<double>::infinity();  // best feasible (true f)
+  bool feasible = false;
+  long evaluations_to_solve = -1;  // t_{p,s}; -1: not solved
+  std::vector<ConvergencePoint> convergence;
+};
+
+struct ComparisonResult {
+  std::vector<std::string> problems;  // labels, in setup order
+  std::vector<std::string> solvers;   // labels, in setup order
+  std::vector<double> f_star;         // per problem
+  std::vector<std::string> f_star_source;  // "given", "best_known", "best_found", "none"
+  double tau = 1e-2;
+  std::vector<RunRecord> runs;        // problem-major, then start, then solver
+
+  // t_{p,s} per instance (rows: (problem, start) in order; columns: solvers); +inf = not solved.
+  std::vector<std::vector<double>> solve_matrix() const;
+  // n_p of each instance row.
+  std::vector<std::size_t> instance_dimensions() const;
+};
+
+// Runs every solver from every start of every problem. Throws abuopt::ConfigError before any
+// run for an empty or inconsistent setup (duplicate labels, budget <= 0, starts < 1, tau outside
+// (0, 1), a solver's options invalid). A run that fails is recorded, never fatal.
+ComparisonResult run_comparison(const ComparisonSetup& setup);
+
+// The starting points of a problem spec (first: initial_point()).
+std::vector<std::vector<double>> starting_points(const Problem& problem, int starts, std::uint64_t seed);
+
+// Evaluations until the first feasible point with f - f* <= tau max(|f*|, 1); -1 if none.
+long evaluations_to_solve(const OptimizationResult& result, double f_star, double tau,
+                          const std::string& true_objective_metric = "noise_free_objective");
+
+// ---- profile arithmetic (t: rows = instances, columns = solvers, +inf = not solved) ----
+// d_s(alpha) for each alpha: fraction of rows with t[p][s] <= alpha (dims[p] + 1).
+std::vector<double> data_profile(const std::vector<std::vector<double>>& t, const std::vector<std::size_t>& dims,
+                                 std::size_t solver, const std::vector<double>& alphas);
+// r_{p,s} = t[p][s] / min_s' t[p][s'] (+inf when t[p][s] is +inf or no solver solved p).
+std::vector<std::vector<double>> performance_ratios(const std::vector<std::vector<double>>& t);
+// rho_s(tau) for each tau: fraction of rows with r_{p,s} <= tau.
+std::vector<double> performance_profile(const std::vector<std::vector<double>>& t, std::size_t solver,
+                                        const std::vector<double>& taus);
+
+// ---- reports ----
+// One row per (problem, solver), over the starts: solved/starts, median evaluations to solve,
+// best feasible true objective, feasible runs, mean evaluations, mean wall time.
+std::string format_table(const ComparisonResult& result);
+
+struct WrittenFiles {
+  std::vector<std::string> files;          // written (paths)
+  std::vector<std::string> skipped_plots;  // PNGs not made (no gnuplot, or gnuplot failed)
+  std::string gnuplot;                     // the gnuplot used ("" if none)
+};
+// Writes into `directory` (created): runs.csv, convergence.csv, data_profile.csv,
+// performance_profile.csv, plots.gp and, when gnuplot is on the PATH and make_plots,
+// data_profile.png, performance_profile.png and convergence_<problem>.png. Throws
+// abuopt::ConfigError if the directory cannot be created or a file cannot be written.
+WrittenFiles write_comparison(const ComparisonResult& result, const std::string& directory, bool make_plots = true);
+
+// The gnuplot executable found on the PATH (or /usr/bin/gnuplot), "" if none is executable.
+std::string find_gnuplot();
+
+}  // namespace abuopt::opt

@@ -1,0 +1,494 @@
+// Comparison of optimisers: runs, solve matrix, data and performance profiles, CSV and gnuplot.
+#include "abuopt/optimizer/benchmarking.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <random>
+#include <set>
+#include <sstream>
+
+#include "abuopt/common/config_error.hpp"
+#include "abuopt/optimizer/algorithms.hpp"
+#include "abuopt/optimizer/minimize.hpp"
+
+namespace abuopt::opt {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double true_objective(const EvaluationRecord& r, const std::string& metric) {
+  if (!metric.empty())
+    if (auto it = r.metrics.find(metric); it != r.metrics.end()) return it->second;
+  return r.objective;
+}
+
+double solved_threshold(double f_star, double tau) { return tau * std::max(std::fabs(f_star), 1.0); }
+
+std::string csv_number(double v) {
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  if (std::isnan(v)) return "nan";
+  return format_number(v);
+}
+
+std::string csv_text(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+std::string file_safe(const std::string& s) {
+  std::string out = s;
+  for (char& c : out)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+  return out;
+}
+
+}  // namespace
+
+SolverSpec solver_spec(const std::string& label, const std::string& algorithm) {
+  SolverSpec s;
+  s.label = label;
+  if (!is_sao_algorithm(algorithm)) find_algorithm(algorithm, "solver " + label + ": algorithm");
+  s.options.algorithm = algorithm;
+  return s;
+}
+
+SolverSpec read_solver_spec(YamlReader& r) {
+  SolverSpec s;
+  const std::string algorithm = r.get_string("algorithm");
+  if (!is_sao_algorithm(algorithm)) find_algorithm(algorithm, r.key_path("algorithm"));
+  s.label = r.get_string_or("label", algorithm);
+  if (s.label.empty()) throw ConfigError(r.key_path("label"), "\"\"", "must not be empty");
+  YamlReader options = r.child("options");
+  if (options.present()) {
+    if (options.has("algorithm"))
+      throw ConfigError(options.key_path("algorithm"), yaml_value_text(options.node()["algorithm"]),
+                        "give the algorithm once, as " + r.key_path("algorithm"));
+    s.options = read_optimizer_options(options);
+  }
+  s.options.algorithm = algorithm;
+  YamlReader sao = r.child("sao");
+  if (sao.present()) {
+    if (!is_sao_algorithm(algorithm))
+      throw ConfigError(r.key_path("sao"), "<section>", "only for algorithm sao (this solver is " + algorithm + ")");
+    s.sao = read_sao_options(sao);
+  }
+  r.finish();
+  return s;
+}
+
+std::vector<std::vector<double>> starting_points(const Problem& problem, int starts, std::uint64_t seed) {
+  std::vector<std::vector<double>> out = {problem.initial_point()};
+  const std::vector<Variable> vars = problem.variables();
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int k = 1; k < starts; ++k) {
+    std::vector<double> x(vars.size());
+    for (std::size_t i = 0; i < vars.size(); ++i) x[i] = vars[i].lower + u(rng) * (vars[i].upper - vars[i].lower);
+    out.push_back(std::move(x));
+  }
+  return out;
+}
+
+long evaluations_to_solve(const OptimizationResult& result, double f_star, double tau, const std::string& metric) {
+  const double threshold = solved_threshold(f_star, tau);
+  for (const EvaluationRecord& h : result.history)
+    if (h.feasible && true_objective(h, metric) - f_star <= threshold) return h.index + 1;
+  return -1;
+}
+
+std::vector<std::vector<double>> ComparisonResult::solve_matrix() const {
+  std::map<std::pair<std::string, int>, std::size_t> row_of;
+  std::vector<std::vector<double>> t;
+  std::map<std::string, std::size_t> col;
+  for (std::size_t s = 0; s < solvers.size(); ++s) col[solvers[s]] = s;
+  for (const RunRecord& r : runs) {
+    auto key = std::make_pair(r.problem, r.start);
+    auto it = row_of.find(key);
+    if (it == row_of.end()) {
+      it = row_of.emplace(key, t.size()).first;
+      t.emplace_back(solvers.size(), kInf);
+    }
+    t[it->second][col.at(r.solver)] = r.evaluations_to_solve > 0 ? static_cast<double>(r.evaluations_to_solve) : kInf;
+  }
+  return t;
+}
+
+std::vector<std::size_t> ComparisonResult::instance_dimensions() const {
+  std::set<std::pair<std::string, int>> seen;
+  std::vector<std::size_t> dims;
+  for (const RunRecord& r : runs)
+    if (seen.insert({r.problem, r.start}).second) dims.push_back(r.dimension);
+  return dims;
+}
+
+std::vector<double> data_profile(const std::vector<std::vector<double>>& t, const std::vector<std::size_t>& dims,
+                                 std::size_t solver, const std::vector<double>& alphas) {
+  std::vector<double> d;
+  for (double alpha : alphas) {
+    std::size_t solved = 0;
+    for (std::size_t p = 0; p < t.size(); ++p)
+      if (t[p][solver] <= alpha * static_cast<double>(dims[p] + 1)) ++solved;
+    d.push_back(t.empty() ? 0.0 : static_cast<double>(solved) / static_cast<double>(t.size()));
+  }
+  return d;
+}
+
+std::vector<std::vector<double>> performance_ratios(const std::vector<std::vector<double>>& t) {
+  std::vector<std::vector<double>> r = t;
+  for (std::size_t p = 0; p < t.size(); ++p) {
+    const double best = *std::min_element(t[p].begin(), t[p].end());
+    for (std::size_t s = 0; s < t[p].size(); ++s) r[p][s] = std::isfinite(best) && std::isfinite(t[p][s]) ? t[p][s] / best : kInf;
+  }
+  return r;
+}
+
+std::vector<double> performance_profile(const std::vector<std::vector<double>>& t, std::size_t solver,
+                                        const std::vector<double>& taus) {
+  const auto r = performance_ratios(t);
+  std::vector<double> rho;
+  for (double tau : taus) {
+    std::size_t count = 0;
+    for (const auto& row : r)
+      if (row[solver] <= tau) ++count;
+    rho.push_back(r.empty() ? 0.0 : static_cast<double>(count) / static_cast<double>(r.size()));
+  }
+  return rho;
+}
+
+ComparisonResult run_comparison(const ComparisonSetup& setup) {
+  if (setup.problems.empty()) throw ConfigError("compare.problems", "[]", "must list at least one problem");
+  if (setup.solvers.empty()) throw ConfigError("compare.solvers", "[]", "must list at least one solver");
+  if (!(setup.tau > 0 && setup.tau < 1)) throw ConfigError("compare.tau", format_number(setup.tau), "must be in (0, 1)");
+  std::set<std::string> labels;
+  for (const ProblemSpec& p : setup.problems) {
+    if (!labels.insert(p.label).second) throw ConfigError("compare.problems", p.label, "duplicate problem label");
+    if (!p.make) throw ConfigError("compare.problems", p.label, "has no factory");
+    if (p.max_evaluations <= 0)
+      throw ConfigError("compare.problems[" + p.label + "].max_evaluations", std::to_string(p.max_evaluations), "must be > 0");
+    if (p.starts < 1) throw ConfigError("compare.problems[" + p.label + "].starts", std::to_string(p.starts), "must be >= 1");
+  }
+  labels.clear();
+  for (const SolverSpec& s : setup.solvers) {
+    if (!labels.insert(s.label).second) throw ConfigError("compare.solvers", s.label, "duplicate solver label");
+    OptimizerOptions check = s.options;
+    if (is_sao_algorithm(check.algorithm)) {
+      check.algorithm = "COBYLA";
+      s.sao.validate("compare.solvers[" + s.label + "].sao");
+    }
+    check.validate();
+  }
+
+  ComparisonResult out;
+  out.tau = setup.tau;
+  for (const SolverSpec& s : setup.solvers) out.solvers.push_back(s.label);
+  for (const ProblemSpec& spec : setup.problems) {
+    out.problems.push_back(spec.label);
+    std::unique_ptr<Problem> probe = spec.make();
+    const auto starts = starting_points(*probe, spec.starts, spec.seed);
+    const std::size_t first_run = out.runs.size();
+    for (int k = 0; k < spec.starts; ++k) {
+      for (const SolverSpec& solver : setup.solvers) {
+        std::unique_ptr<Problem> problem = spec.make();
+        OptimizerOptions o = solver.options;
+        o.max_evaluations = spec.max_evaluations;
+        o.constraint_tolerance = spec.constraint_tolerance;
+        o.seed = spec.seed + static_cast<unsigned long>(k);
+        o.keep_history = true;
+        RunRecord rec;
+        rec.problem = spec.label;
+        rec.solver = solver.label;
+        rec.start = k;
+        rec.dimension = problem->dimension();
+        rec.x0 = starts[k];
+        try {
+          rec.result = minimize_any(*problem, o, solver.sao, starts[k]);
+        } catch (const ConfigError& e) {
+          // e.g. a bound-only global algorithm on a constrained problem: recorded as a failed run
+          rec.result.problem_name = problem->name();
+          rec.result.algorithm = o.algorithm;
+          rec.result.reason = TerminationReason::failure;
+          rec.result.message = e.what();
+        }
+        double best = kInf;
+        for (const EvaluationRecord& h : rec.result.history) {
+          if (!h.feasible) continue;
+          const double f = true_objective(h, setup.true_objective_metric);
+          if (f < best) {
+            best = f;
+            rec.convergence.push_back({h.index + 1, f});
+          }
+        }
+        rec.best_true_objective = best;
+        rec.feasible = std::isfinite(best);
+        out.runs.push_back(std::move(rec));
+      }
+    }
+    // the reference value f*
+    double f_star = kInf;
+    std::string source = "none";
+    if (spec.f_star) {
+      f_star = *spec.f_star;
+      source = "given";
+    } else if (auto bk = probe->best_known()) {
+      f_star = bk->objective;
+      source = "best_known";
+    } else {
+      for (std::size_t i = first_run; i < out.runs.size(); ++i) f_star = std::min(f_star, out.runs[i].best_true_objective);
+      if (std::isfinite(f_star)) source = "best_found";
+    }
+    out.f_star.push_back(f_star);
+    out.f_star_source.push_back(source);
+    for (std::size_t i = first_run; i < out.runs.size(); ++i) {
+      RunRecord& rec = out.runs[i];
+      rec.evaluations_to_solve =
+          std::isfinite(f_star) ? evaluations_to_solve(rec.result, f_star, setup.tau, setup.true_objective_metric) : -1;
+      if (setup.on_run) setup.on_run(rec);
+    }
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reports
+
+std::string format_table(const ComparisonResult& r) {
+  std::ostringstream os;
+  os << "tau = " << format_number(r.tau) << ": solved = feasible and f - f* <= tau max(|f*|, 1)\n";
+  os << std::left << std::setw(22) << "problem" << std::setw(16) << "solver" << std::right << std::setw(8) << "solved"
+     << std::setw(12) << "evals@tau" << std::setw(16) << "best f" << std::setw(10) << "feasible" << std::setw(10)
+     << "evals" << std::setw(11) << "time [s]" << "\n";
+  for (std::size_t p = 0; p < r.problems.size(); ++p) {
+    for (const std::string& solver : r.solvers) {
+      std::vector<long> solved;
+      int runs = 0, feasible = 0;
+      double best = kInf, evals = 0, time = 0;
+      for (const RunRecord& run : r.runs) {
+        if (run.problem != r.problems[p] || run.solver != solver) continue;
+        ++runs;
+        if (run.evaluations_to_solve > 0) solved.push_back(run.evaluations_to_solve);
+        if (run.feasible) ++feasible;
+        best = std::min(best, run.best_true_objective);
+        evals += static_cast<double>(run.result.evaluations);
+        time += run.result.wall_time_s;
+      }
+      if (runs == 0) continue;
+      std::string median = "-";
+      if (!solved.empty()) {
+        std::sort(solved.begin(), solved.end());
+        const std::size_t m = solved.size();
+        const double med = m % 2 ? static_cast<double>(solved[m / 2]) : 0.5 * static_cast<double>(solved[m / 2 - 1] + solved[m / 2]);
+        median = format_number(med);
+      }
+      std::ostringstream bestf;
+      if (std::isfinite(best)) bestf << std::setprecision(8) << best;
+      else bestf << "-";
+      std::ostringstream t;
+      t << std::fixed << std::setprecision(3) << time / runs;
+      os << std::left << std::setw(22) << r.problems[p] << std::setw(16) << solver << std::right << std::setw(8)
+         << (std::to_string(solved.size()) + "/" + std::to_string(runs)) << std::setw(12) << median << std::setw(16)
+         << bestf.str() << std::setw(10) << (std::to_string(feasible) + "/" + std::to_string(runs)) << std::setw(10)
+         << static_cast<long>(std::lround(evals / runs)) << std::setw(11) << t.str() << "\n";
+    }
+    os << std::left << std::setw(22) << "" << "f* = " << std::setprecision(10) << r.f_star[p] << " ("
+       << r.f_star_source[p] << ")\n";
+  }
+  return os.str();
+}
+
+std::string find_gnuplot() {
+  if (const char* path = std::getenv("PATH")) {
+    std::stringstream ss(path);
+    std::string dir;
+    while (std::getline(ss, dir, ':')) {
+      if (dir.empty()) continue;
+      const std::string candidate = dir + "/gnuplot";
+      if (access(candidate.c_str(), X_OK) == 0) return candidate;
+    }
+  }
+  if (access("/usr/bin/gnuplot", X_OK) == 0) return "/usr/bin/gnuplot";
+  return "";
+}
+
+namespace {
+
+std::ofstream open_out(const std::filesystem::path& path, WrittenFiles& written) {
+  std::ofstream f(path);
+  if (!f) throw ConfigError("output file '" + path.string() + "' cannot be written");
+  written.files.push_back(path.string());
+  return f;
+}
+
+// Abscissae of the profiles: alpha in [0, max budget / (n_p + 1)], tau in [1, max finite ratio].
+std::vector<double> alpha_grid(const ComparisonResult& r) {
+  double top = 1;
+  for (const RunRecord& run : r.runs)
+    top = std::max(top, static_cast<double>(run.result.evaluations) / static_cast<double>(run.dimension + 1));
+  std::vector<double> a;
+  const int steps = 200;
+  for (int i = 0; i <= steps; ++i) a.push_back(top * i / steps);
+  return a;
+}
+
+std::vector<double> tau_grid(const std::vector<std::vector<double>>& t) {
+  double top = 2;
+  for (const auto& row : performance_ratios(t))
+    for (double v : row)
+      if (std::isfinite(v)) top = std::max(top, v * 1.1);
+  std::vector<double> taus;
+  const int steps = 200;
+  for (int i = 0; i <= steps; ++i) taus.push_back(std::pow(top, static_cast<double>(i) / steps));
+  return taus;
+}
+
+}  // namespace
+
+WrittenFiles write_comparison(const ComparisonResult& r, const std::string& directory, bool make_plots) {
+  namespace fs = std::filesystem;
+  WrittenFiles written;
+  std::error_code ec;
+  fs::create_directories(directory, ec);
+  if (ec) throw ConfigError("output directory '" + directory + "' cannot be created: " + ec.message());
+  const fs::path dir(directory);
+
+  {
+    auto f = open_out(dir / "runs.csv", written);
+    f << "problem,start,solver,algorithm,dimension,x0,reason,best_true_objective,feasible,objective,max_violation,"
+         "evaluations,evaluations_to_tau,f_star,wall_time_s,message\n";
+    for (const RunRecord& run : r.runs) {
+      std::string x0;
+      for (double v : run.x0) x0 += (x0.empty() ? "" : " ") + format_number(v);
+      const std::size_t p = static_cast<std::size_t>(
+          std::find(r.problems.begin(), r.problems.end(), run.problem) - r.problems.begin());
+      f << csv_text(run.problem) << "," << run.start << "," << csv_text(run.solver) << ","
+        << csv_text(run.result.algorithm) << "," << run.dimension << "," << x0 << "," << to_string(run.result.reason)
+        << "," << csv_number(run.best_true_objective) << "," << (run.feasible ? 1 : 0) << ","
+        << csv_number(run.result.objective) << "," << csv_number(run.result.max_violation) << ","
+        << run.result.evaluations << "," << run.evaluations_to_solve << "," << csv_number(r.f_star[p]) << ","
+        << csv_number(run.result.wall_time_s) << "," << csv_text(run.result.message) << "\n";
+    }
+  }
+  {
+    auto f = open_out(dir / "convergence.csv", written);
+    f << "problem,start,solver,evaluation,best_feasible_true_objective,relative_gap\n";
+    for (const RunRecord& run : r.runs) {
+      const std::size_t p = static_cast<std::size_t>(
+          std::find(r.problems.begin(), r.problems.end(), run.problem) - r.problems.begin());
+      for (const ConvergencePoint& c : run.convergence) {
+        const double gap = (c.best - r.f_star[p]) / std::max(std::fabs(r.f_star[p]), 1.0);
+        f << csv_text(run.problem) << "," << run.start << "," << csv_text(run.solver) << "," << c.evaluation << ","
+          << csv_number(c.best) << "," << csv_number(gap) << "\n";
+      }
+    }
+  }
+  const auto t = r.solve_matrix();
+  const auto dims = r.instance_dimensions();
+  {
+    auto f = open_out(dir / "data_profile.csv", written);
+    const auto alphas = alpha_grid(r);
+    std::vector<std::vector<double>> d;
+    for (std::size_t s = 0; s < r.solvers.size(); ++s) d.push_back(data_profile(t, dims, s, alphas));
+    f << "alpha";
+    for (const auto& s : r.solvers) f << "," << csv_text(s);
+    f << "\n";
+    for (std::size_t i = 0; i < alphas.size(); ++i) {
+      f << format_number(alphas[i]);
+      for (std::size_t s = 0; s < r.solvers.size(); ++s) f << "," << format_number(d[s][i]);
+      f << "\n";
+    }
+  }
+  {
+    auto f = open_out(dir / "performance_profile.csv", written);
+    const auto taus = tau_grid(t);
+    std::vector<std::vector<double>> rho;
+    for (std::size_t s = 0; s < r.solvers.size(); ++s) rho.push_back(performance_profile(t, s, taus));
+    f << "tau";
+    for (const auto& s : r.solvers) f << "," << csv_text(s);
+    f << "\n";
+    for (std::size_t i = 0; i < taus.size(); ++i) {
+      f << format_number(taus[i]);
+      for (std::size_t s = 0; s < r.solvers.size(); ++s) f << "," << format_number(rho[s][i]);
+      f << "\n";
+    }
+  }
+
+  // convergence curves of start 0, one data block per solver, per problem
+  std::vector<std::string> pngs = {"data_profile.png", "performance_profile.png"};
+  std::vector<std::string> conv_files;
+  for (std::size_t p = 0; p < r.problems.size(); ++p) {
+    const std::string name = "convergence_" + file_safe(r.problems[p]) + ".dat";
+    auto f = open_out(dir / name, written);
+    for (const std::string& solver : r.solvers) {
+      f << "# " << solver << "\n";
+      for (const RunRecord& run : r.runs) {
+        if (run.problem != r.problems[p] || run.solver != solver || run.start != 0) continue;
+        const double scale = std::max(std::fabs(r.f_star[p]), 1.0);
+        for (std::size_t i = 0; i < run.convergence.size(); ++i) {
+          const double gap = std::max((run.convergence[i].best - r.f_star[p]) / scale, 1e-12);
+          f << run.convergence[i].evaluation << " " << format_number(gap) << "\n";
+          const long next = i + 1 < run.convergence.size() ? run.convergence[i + 1].evaluation : run.result.evaluations;
+          if (next > run.convergence[i].evaluation) f << next << " " << format_number(gap) << "\n";  // staircase
+        }
+      }
+      f << "\n\n";
+    }
+    conv_files.push_back(name);
+    pngs.push_back("convergence_" + file_safe(r.problems[p]) + ".png");
+  }
+
+  {
+    auto f = open_out(dir / "plots.gp", written);
+    const std::size_t ns = r.solvers.size();
+    f << "# gnuplot script written by abuopt compare; run: gnuplot plots.gp (in this directory)\n"
+      << "set datafile separator ','\nset terminal pngcairo size 900,600 noenhanced\nset key bottom right\n"
+      << "set grid\nset yrange [0:1.05]\n";
+    f << "set output 'data_profile.png'\nset title 'Data profile (tau = " << format_number(r.tau)
+      << "): fraction of problems solved within alpha (n_p+1) evaluations'\n"
+      << "set xlabel 'alpha = evaluations / (n_p + 1)'\nset ylabel 'd_s(alpha)'\nplot ";
+    for (std::size_t s = 0; s < ns; ++s)
+      f << (s ? ", " : "") << "'data_profile.csv' using 1:" << s + 2 << " with steps lw 2 title '" << r.solvers[s]
+        << "'";
+    f << "\nset output 'performance_profile.png'\nset title 'Performance profile (tau = " << format_number(r.tau)
+      << "): evaluations relative to the best solver'\nset logscale x 2\n"
+      << "set xlabel 'ratio to the best solver'\nset ylabel 'rho_s(ratio)'\nplot ";
+    for (std::size_t s = 0; s < ns; ++s)
+      f << (s ? ", " : "") << "'performance_profile.csv' using 1:" << s + 2 << " with steps lw 2 title '"
+        << r.solvers[s] << "'";
+    f << "\nunset logscale x\nset datafile separator whitespace\nset autoscale y\nset logscale y\nset key top right\n"
+      << "set format y '%.0e'\n";
+    for (std::size_t p = 0; p < r.problems.size(); ++p) {
+      f << "set output '" << pngs[2 + p] << "'\nset title 'Convergence on " << r.problems[p]
+        << " (first start): best feasible (f - f*) / max(|f*|, 1)'\nset xlabel 'evaluations'\n"
+        << "set ylabel 'relative gap'\nplot ";
+      for (std::size_t s = 0; s < ns; ++s)
+        f << (s ? ", " : "") << "'" << conv_files[p] << "' index " << s << " using 1:2 with lines lw 2 title '"
+          << r.solvers[s] << "'";
+      f << "\n";
+    }
+    f << "unset output\n";
+  }
+
+  written.gnuplot = make_plots ? find_gnuplot() : "";
+  if (written.gnuplot.empty()) {
+    written.skipped_plots = pngs;
+  } else {
+    const std::string cmd = "cd '" + fs::absolute(dir).string() + "' && '" + written.gnuplot + "' plots.gp 2>gnuplot.log";
+    const int rc = std::system(cmd.c_str());
+    for (const std::string& png : pngs) {
+      if (rc == 0 && fs::exists(dir / png) && fs::file_size(dir / png) > 0) written.files.push_back((dir / png).string());
+      else written.skipped_plots.push_back(png);
+    }
+  }
+  return written;
+}
+
+}  // namespace abuopt::opt
