@@ -70,6 +70,8 @@ void SaoOptions::validate(const std::string& p) const {
   require_choice(p, "doe", doe, doe_choices());
   require_choice(p, "subproblem_solver", subproblem_solver, solver_choices());
   require(doe_points >= 0, p, "doe_points", doe_points, "must be >= 0 (0: automatic)");
+  require(std::isfinite(doe_points_factor) && doe_points_factor >= 1 && doe_points_factor <= 10, p,
+          "doe_points_factor", doe_points_factor, "must be in [1, 10]");
   require(std::isfinite(reuse_distance) && reuse_distance > 0 && reuse_distance <= 1, p, "reuse_distance",
           reuse_distance, "must be in (0, 1]");
   require(std::isfinite(neighbourhood) && neighbourhood >= 1 && neighbourhood <= 10, p, "neighbourhood",
@@ -113,6 +115,7 @@ SaoOptions read_sao_options(YamlReader& r) {
   o.surrogate = r.get_choice_or("surrogate", o.surrogate, surrogate_choices());
   o.doe = r.get_choice_or("doe", o.doe, doe_choices());
   o.doe_points = static_cast<int>(r.get_int_or("doe_points", o.doe_points, Rule::in_range(0, 100000)));
+  o.doe_points_factor = r.get_double_or("doe_points_factor", o.doe_points_factor);
   o.reuse_distance = r.get_double_or("reuse_distance", o.reuse_distance);
   o.neighbourhood = r.get_double_or("neighbourhood", o.neighbourhood);
   o.initial_radius = r.get_double_or("initial_radius", o.initial_radius);
@@ -416,10 +419,11 @@ std::string SaoRun::planned_basis() const { return sao_.surrogate; }
 int SaoRun::wanted_points(const std::string& basis) const {
   if (sao_.doe_points > 0) return sao_.doe_points;
   using surrogate::Basis;
-  if (basis == "linear") return n_ + 1;
-  if (basis == "interactions") return surrogate::terms_count(Basis::kInteractions, n_);
-  if (basis == "quadratic") return surrogate::terms_count(Basis::kQuadratic, n_);
-  return 2 * n_ + 1;  // auto, pure_quadratic, kriging
+  int count = 2 * n_ + 1;  // auto, pure_quadratic, kriging
+  if (basis == "linear") count = n_ + 1;
+  if (basis == "interactions") count = surrogate::terms_count(Basis::kInteractions, n_);
+  if (basis == "quadratic") count = surrogate::terms_count(Basis::kQuadratic, n_);
+  return static_cast<int>(std::ceil(sao_.doe_points_factor * count));
 }
 
 // Candidate DOE designs in [-1,1]^n for the region, in order of preference.

@@ -41,7 +41,7 @@ struct Case {
   long budget;
   double f_tol;               // |f - f*| <= f_tol * max(1, |f*|), f noise-free
   double constraint_tol = 1e-6;
-  bool noisy_settings = false;  // doe_points = 2 (2n + 1): least squares over twice the terms
+  bool noisy_settings = false;  // doe_points_factor = 2: least squares over about twice the terms
 };
 
 std::string case_name(const testing::TestParamInfo<Case>& info) { return info.param.problem; }
@@ -56,7 +56,7 @@ TEST_P(SaoConvergence, ReachesBestKnown) {
   o.max_evaluations = c.budget;
   o.constraint_tolerance = c.constraint_tol;
   opt::SaoOptions sao;
-  if (c.noisy_settings) sao.doe_points = 2 * (2 * static_cast<int>(problem->dimension()) + 1);
+  if (c.noisy_settings) sao.doe_points_factor = 2;
   const opt::OptimizationResult r = opt::minimize_sao(*problem, o, sao);
   std::cout << "[measure] " << c.problem << ": " << r.brief_report()
             << "; evaluations to 1%: " << evaluations_to_one_percent(r, best.objective) << "\n";

@@ -63,6 +63,9 @@ struct SaoOptions {
   // Points wanted in the region before fitting; 0: automatic (linear: n+1, interactions: its
   // term count, pure_quadratic / auto / kriging: 2n+1, quadratic: (n+1)(n+2)/2).
   int doe_points = 0;
+  // Multiplies the automatic count (doe_points == 0). Noisy problems: 2 (least squares over about
+  // twice as many points as terms smooths the noise instead of interpolating it). In [1, 10].
+  double doe_points_factor = 1.0;
   // A DOE candidate within this distance (infinity norm, local coordinates where the region is
   // [-1,1]^n) of a known point is covered by it and not evaluated. In (0, 1].
   double reuse_distance = 0.3;

@@ -1,0 +1,158 @@
+// abuopt compare CONFIG: runs several optimisers (NLopt algorithms, Ipopt, SAO variants) on several
+// problems from several starts, prints a table, and writes runs/convergence/profile CSVs and plots.
+//
+// Config (see configs/compare/benchmarks.yaml):
+//   tau: 0.01                        # solved: feasible and f - f* <= tau max(|f*|, 1)
+//   problems:
+//     - benchmark: rosenbrock        # a name of make_benchmark (noisy_<name> too)
+//       label: rosenbrock2           # optional (default: the benchmark name)
+//       dimension: 2                 # rosenbrock only
+//       noise_amplitude: 1e-3        # noisy_* only
+//       noise_seed: 1                # noisy_* only
+//       max_evaluations: 300         # budget of every run
+//       starts: 3                    # initial point + 2 seeded random points
+//       seed: 1
+//       constraint_tolerance: 1e-6
+//       f_star: 0                    # optional reference (default: best_known)
+//   solvers:
+//     - {label: SAO, algorithm: sao, sao: {...}}
+//     - {label: COBYLA, algorithm: cobyla, options: {...}}   # options: the optimizer: keys
+#include <chrono>
+#include <ctime>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "abuopt/common/config_error.hpp"
+#include "abuopt/optimizer/benchmarking.hpp"
+#include "abuopt/problems/benchmarks/benchmark_factory.hpp"
+#include "commands/commands.hpp"
+
+namespace abuopt::app {
+
+namespace {
+
+struct CompareArgs {
+  std::string config;
+  std::string out;
+  bool json = false;
+};
+
+opt::ProblemSpec read_problem(YamlReader& r) {
+  opt::ProblemSpec spec;
+  const std::string name = r.get_string("benchmark");
+  problems::BenchmarkSettings settings;
+  settings.dimension = static_cast<int>(r.get_int_or("dimension", settings.dimension, Rule::in_range(2, 10)));
+  settings.noise_amplitude = r.get_double_or("noise_amplitude", settings.noise_amplitude, Rule::in_range(0, 0.999));
+  settings.noise_seed =
+      static_cast<std::uint64_t>(r.get_int_or("noise_seed", static_cast<long>(settings.noise_seed), Rule::non_negative()));
+  problems::make_benchmark(name, settings);  // an unknown name is a ConfigError now, listing the valid ones
+  spec.label = r.get_string_or("label", name == "rosenbrock" || name == "noisy_rosenbrock"
+                                            ? name + std::to_string(settings.dimension)
+                                            : name);
+  spec.make = [name, settings] { return problems::make_benchmark(name, settings); };
+  spec.max_evaluations = r.get_int_or("max_evaluations", 200, Rule::positive());
+  spec.starts = static_cast<int>(r.get_int_or("starts", 1, Rule::in_range(1, 1000)));
+  spec.seed = static_cast<std::uint64_t>(r.get_int_or("seed", 1, Rule::non_negative()));
+  spec.constraint_tolerance = r.get_double_or("constraint_tolerance", 1e-6, Rule::non_negative());
+  if (r.has("f_star")) spec.f_star = r.get_double("f_star");
+  r.finish();
+  return spec;
+}
+
+std::string timestamp() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  localtime_r(&t, &tm);
+  std::ostringstream os;
+  os << std::put_time(&tm, "%Y%m%d-%H%M%S");
+  return os.str();
+}
+
+nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+int run_compare(const CompareArgs& a) {
+  YamlReader root = YamlReader::load_file(a.config);
+  opt::ComparisonSetup setup;
+  setup.tau = root.get_double_or("tau", setup.tau, Rule::in_range(1e-12, 0.999));
+  for (YamlReader& p : root.children("problems")) setup.problems.push_back(read_problem(p));
+  for (YamlReader& s : root.children("solvers")) setup.solvers.push_back(opt::read_solver_spec(s));
+  root.finish();
+  if (setup.problems.empty()) throw ConfigError("problems", "<missing>", "must list at least one problem");
+  if (setup.solvers.empty()) throw ConfigError("solvers", "<missing>", "must list at least one solver");
+
+  std::size_t total = 0;
+  for (const auto& p : setup.problems) total += static_cast<std::size_t>(p.starts) * setup.solvers.size();
+  std::size_t done = 0;
+  setup.on_run = [&](const opt::RunRecord& r) {
+    ++done;
+    std::cerr << "[" << done << "/" << total << "] " << r.problem << " start " << r.start << " " << r.solver << ": "
+              << r.result.brief_report() << "\n";
+  };
+  const opt::ComparisonResult result = opt::run_comparison(setup);
+
+  const std::string out = a.out.empty() ? "results/compare-" + timestamp() : a.out;
+  const opt::WrittenFiles files = opt::write_comparison(result, out);
+
+  if (a.json) {
+    nlohmann::json j;
+    j["config"] = a.config;
+    j["tau"] = result.tau;
+    j["out"] = out;
+    j["problems"] = nlohmann::json::array();
+    for (std::size_t p = 0; p < result.problems.size(); ++p)
+      j["problems"].push_back({{"label", result.problems[p]},
+                               {"f_star", number(result.f_star[p])},
+                               {"f_star_source", result.f_star_source[p]}});
+    j["solvers"] = result.solvers;
+    j["runs"] = nlohmann::json::array();
+    for (const auto& r : result.runs)
+      j["runs"].push_back({{"problem", r.problem},
+                           {"start", r.start},
+                           {"solver", r.solver},
+                           {"algorithm", r.result.algorithm},
+                           {"reason", opt::to_string(r.result.reason)},
+                           {"best_true_objective", number(r.best_true_objective)},
+                           {"feasible", r.feasible},
+                           {"evaluations", r.result.evaluations},
+                           {"evaluations_to_tau", r.evaluations_to_solve},
+                           {"wall_time_s", r.result.wall_time_s}});
+    j["files"] = files.files;
+    j["skipped_plots"] = files.skipped_plots;
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << opt::format_table(result);
+    std::cout << "\nwritten to " << out << "/: runs.csv, convergence.csv, data_profile.csv, performance_profile.csv, "
+                                         "plots.gp";
+    if (files.skipped_plots.empty()) std::cout << " and the PNG plots (gnuplot " << files.gnuplot << ")\n";
+    else std::cout << "\n";
+  }
+  if (!files.skipped_plots.empty()) {
+    std::cerr << "plots skipped (" << (files.gnuplot.empty() ? "gnuplot not found" : "gnuplot failed, see gnuplot.log")
+              << "):";
+    for (const auto& s : files.skipped_plots) std::cerr << " " << s;
+    std::cerr << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+void register_compare(CLI::App& app) {
+  auto args = std::make_shared<CompareArgs>();
+  CLI::App* sub = app.add_subcommand(
+      "compare",
+      "Compare optimisers (NLopt algorithms, IPOPT, SAO) on benchmark problems from several starts, each\n"
+      "with an evaluation budget: a table (solved runs, evaluations to reach tau, best value, feasibility,\n"
+      "time), convergence curves, data profiles and performance profiles (CSV, and PNG with gnuplot).\n"
+      "Exit status: 0 ok, 2 bad input.");
+  sub->add_option("config", args->config, "YAML config (tau, problems, solvers; see configs/compare/)")->required();
+  sub->add_option("--out", args->out, "output directory (default results/compare-<timestamp>/)");
+  sub->add_flag("--json", args->json, "print one JSON object (runs and files) instead of the table");
+  sub->callback([args] { set_exit_code(run_compare(*args)); });
+}
+
+}  // namespace abuopt::app
