@@ -12,7 +12,6 @@ int exit_code();
 void register_simulate(CLI::App& app);
 void register_montecarlo(CLI::App& app);
 void register_eqset(CLI::App& app);
-void register_reproduce(CLI::App& app);
 void register_compare(CLI::App& app);
 
 }  // namespace abuopt::app
