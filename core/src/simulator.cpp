@@ -74,8 +74,24 @@ struct RunState {
   ModelForces forces;
   std::vector<double> off_a, off_b;
   long rhs_evals = 0;
+  // Fast path while every ball is stuck (event-driven, ideal motor): beta' = beta'' = 0, so the
+  // table rows reduce to x'' = -h_x, y'' = -h_y with the ball sums sum mbar_i (c_i, s_i) fixed.
+  // The full evaluation is still used for the root functions (they need fn, fw).
+  bool frozen = false;
+  double frozen_sc = 0, frozen_ss = 0;
 
   explicit RunState(const AbuParameters& p) : params(p), nd(NondimParameters::from(p)), model(nd) {}
+
+  // Call whenever the modes change (event-driven only).
+  void modes_changed(const double* y) {
+    frozen = !pi_motor && opt.method == FrictionMethod::EventDriven;
+    frozen_sc = frozen_ss = 0;
+    for (std::size_t i = 0; i < n && frozen; ++i) {
+      frozen = modes[i] == BallMode::Stick;
+      frozen_sc += nd.mbar[i] * std::cos(y[4 + i]);
+      frozen_ss += nd.mbar[i] * std::sin(y[4 + i]);
+    }
+  }
 };
 
 struct Speed {
@@ -129,17 +145,30 @@ Speed evaluate_forces(RunState& rs, double tbar, const double* y) {
 // at every right-hand-side call. A stuck ball's angle is frozen (the report reset beta' = 0 every
 // step to the same effect).
 void switch_modes(RunState& rs, double tbar, const double* y) {
-  Speed sp = rs.pi_motor ? Speed{y[4 + 2 * rs.n + 1], 0.0} : ideal_speed(rs, tbar);
-  if (rs.pi_motor) {
-    // modes from the ideal-motor estimate of W' are good enough for choosing; forces follow.
-    sp.Wp = 0;
-  }
+  // The PI motor's W' depends on the modes through the friction feedback: the W' of the current
+  // modes is used to choose the new ones.
+  const Speed sp = rs.pi_motor ? evaluate_forces(rs, tbar, y) : ideal_speed(rs, tbar);
   rs.model.choose_modes(y, sp.W, sp.Wp, rs.mu, rs.opt.switch_band, rs.modes.data(), rs.forces);
 }
 
 void rhs_plain(double tbar, const double* y, double* yd, void* user) {
   auto& rs = *static_cast<RunState*>(user);
   ++rs.rhs_evals;
+  if (rs.frozen) {
+    const Speed sp = ideal_speed(rs, tbar);
+    const double W = sp.W, Wp = sp.Wp, W2 = W * W, bb = rs.nd.bbar;
+    const double x = y[0], yy = y[1], xd = y[2], ydd = y[3];
+    const double hx = -2.0 * ydd * W - x * W2 - rs.nd.mbar_I * rs.nd.ebar * W2 - Wp * (yy + rs.frozen_ss) -
+                      W2 * rs.frozen_sc + x + 2.0 * bb * (xd - yy * W);
+    const double hy = 2.0 * xd * W - yy * W2 + Wp * (x + rs.nd.mbar_I * rs.nd.ebar + rs.frozen_sc) -
+                      W2 * rs.frozen_ss + yy + 2.0 * bb * (ydd + x * W);
+    yd[0] = xd;
+    yd[1] = ydd;
+    yd[2] = -hx;
+    yd[3] = -hy;
+    std::fill(yd + 4, yd + 4 + 2 * rs.n, 0.0);
+    return;
+  }
   if (rs.opt.method == FrictionMethod::SwitchModel) switch_modes(rs, tbar, y);
   const Speed sp = evaluate_forces(rs, tbar, y);
   const std::size_t n = rs.n;
@@ -516,6 +545,7 @@ RunOutcome Simulator::run(const std::vector<double>& beta0, const RunOverrides& 
       sp.Wp = evaluate_forces(rs, tiny, yprobe.data()).Wp;
     }
     rs.model.choose_modes(yprobe.data(), sp.W, sp.Wp, rs.mu, 0.0, rs.modes.data(), rs.forces);
+    rs.modes_changed(y.data());
   }
 
   std::unique_ptr<Integrator> integ_ptr = make_integrator(rs, nvar, event_driven);
@@ -602,6 +632,7 @@ RunOutcome Simulator::run(const std::vector<double>& beta0, const RunOverrides& 
       }
       const Speed sp = rs.pi_motor ? sp0 : ideal_speed(rs, t);
       rs.model.choose_modes(y.data(), sp.W, sp.Wp, rs.mu, 0.0, rs.modes.data(), rs.forces, &fixed);
+      rs.modes_changed(y.data());
       ++out.events;
       recent_events.push_back(t);
       while (!recent_events.empty() && (t - recent_events.front()) > rs.opt.chatter_window_s * w) recent_events.pop_front();
