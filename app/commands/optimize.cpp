@@ -1,0 +1,428 @@
+// abuopt optimize CONFIG: optimises a startup profile (design variables: segment end frequencies
+// and durations) by Monte Carlo on common random numbers, with an evaluation archive so that a
+// rerun of the same command resumes; then checks the best design out of sample against the
+// report's final profile. docs/optimize.md describes every key and output.
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "abuopt/common/config_error.hpp"
+#include "abuopt/common/gnuplot.hpp"
+#include "abuopt/core/simulation_config.hpp"
+#include "abuopt/optimizer/evaluation_archive.hpp"
+#include "abuopt/optimizer/minimize.hpp"
+#include "abuopt/optimizer/optimizer_options.hpp"
+#include "abuopt/optimizer/sao.hpp"
+#include "abuopt/problems/startup_profile_problem.hpp"
+#include "commands/commands.hpp"
+
+namespace abuopt::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+using opt::format_number;
+using problems::StartupProfileProblem;
+
+struct OptimizeArgs {
+  std::string config;
+  std::string out;
+  bool json = false;
+  std::optional<long> max_evaluations;
+  std::optional<long> threads;
+};
+
+struct LoadedConfig {
+  problems::StartupProfileSettings settings;
+  opt::OptimizerOptions options;
+  opt::SaoOptions sao;
+};
+
+// The optimizer section, with "SAO" accepted as algorithm (read_optimizer_options knows the NLopt
+// and Ipopt names only; the SAO-specific keys are in the `sao` section).
+opt::OptimizerOptions read_optimizer_section(YamlReader& root) {
+  YamlReader section = root.child("optimizer");
+  if (section.present() && section.node()["algorithm"] && section.node()["algorithm"].IsScalar() &&
+      opt::is_sao_algorithm(section.node()["algorithm"].Scalar())) {
+    YAML::Node copy = YAML::Clone(section.node());
+    copy["algorithm"] = "cobyla";
+    YamlReader substitute(copy, section.path());
+    opt::OptimizerOptions o = opt::read_optimizer_options(substitute);
+    o.algorithm = "SAO";
+    return o;
+  }
+  return opt::read_optimizer_options(section);
+}
+
+LoadedConfig load_config(const OptimizeArgs& a) {
+  LoadedConfig c;
+  YamlReader root = YamlReader::load_file(a.config);
+  c.settings = problems::read_startup_profile_settings(root);
+  c.options = read_optimizer_section(root);
+  const bool sao = opt::is_sao_algorithm(c.options.algorithm);
+  if (root.has("sao")) {
+    YamlReader s = root.child("sao");
+    if (!sao)
+      throw ConfigError("sao", yaml_value_text(s.node()),
+                        "is only used with optimizer.algorithm: SAO (algorithm is " + c.options.algorithm + ")");
+    c.sao = opt::read_sao_options(s);
+  } else {
+    root.child("sao");
+  }
+  root.finish();
+  if (a.max_evaluations) {
+    if (*a.max_evaluations < 1)
+      throw ConfigError("--max-evaluations", std::to_string(*a.max_evaluations), "must be >= 1");
+    c.options.max_evaluations = *a.max_evaluations;
+  }
+  if (a.threads) {
+    if (*a.threads < 0) throw ConfigError("--threads", std::to_string(*a.threads), "must be >= 0 (0 = all cores)");
+    c.settings.threads = static_cast<std::size_t>(*a.threads);
+  }
+  if (!sao) c.options.validate();
+  return c;
+}
+
+std::string vector_text(const std::vector<opt::Variable>& vars, const std::vector<double>& x) {
+  std::ostringstream os;
+  os << std::setprecision(5);
+  for (std::size_t i = 0; i < x.size() && i < vars.size(); ++i) os << (i ? " " : "") << vars[i].name << "=" << x[i];
+  return os.str();
+}
+
+std::string profile_text(const StartupProfile& p) {
+  std::ostringstream os;
+  os << std::setprecision(5);
+  double f = p.start_frequency_hz();
+  for (std::size_t i = 0; i < p.segments().size(); ++i) {
+    const auto& s = p.segments()[i];
+    os << (i ? ", " : "") << f << "->" << s.end_frequency_hz << " Hz/" << s.duration_s << " s";
+    f = s.end_frequency_hz;
+  }
+  os << " (" << p.duration_s() << " s)";
+  return os.str();
+}
+
+nlohmann::json profile_json(const StartupProfile& p) {
+  nlohmann::json segs = nlohmann::json::array();
+  for (const auto& s : p.segments()) segs.push_back({{"end_frequency_hz", s.end_frequency_hz}, {"duration_s", s.duration_s}});
+  return {{"start_frequency_hz", p.start_frequency_hz()}, {"segments", segs}, {"duration_s", p.duration_s()}};
+}
+
+nlohmann::json evaluation_json(const opt::Evaluation& e, const std::vector<std::string>& names) {
+  nlohmann::json j = {{"ok", e.ok}, {"objective", e.objective}, {"metrics", e.metrics}};
+  if (!e.message.empty()) j["message"] = e.message;
+  nlohmann::json g = nlohmann::json::object();
+  for (std::size_t i = 0; i < e.inequality.size() && i < names.size(); ++i) g[names[i]] = e.inequality[i];
+  j["constraints"] = g;
+  j["max_violation"] = opt::max_constraint_violation(e);
+  return j;
+}
+
+std::string csv_number(double v) { return std::isfinite(v) ? format_number(v) : (std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf")); }
+
+std::string csv_text(std::string s) {
+  for (char& c : s)
+    if (c == '\n' || c == '\r') c = ' ';
+  if (s.find_first_of(",\"") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+std::ofstream open_out(const fs::path& p) {
+  std::ofstream f(p);
+  if (!f) throw ConfigError("--out", p.parent_path().string(), "cannot write " + p.string());
+  return f;
+}
+
+void write_history_csv(const fs::path& path, const opt::OptimizationResult& r) {
+  std::set<std::string> metric_names;
+  for (const auto& h : r.history)
+    for (const auto& [k, v] : h.metrics) metric_names.insert(k);
+  std::ofstream f = open_out(path);
+  f << "evaluation,from_archive,for_gradient,ok,feasible,objective,max_violation";
+  for (const auto& n : r.variable_names) f << "," << n;
+  for (const auto& n : r.inequality_names) f << ",g_" << n;
+  for (const auto& n : metric_names) f << "," << n;
+  f << ",wall_time_s,elapsed_s,message\n";
+  for (const auto& h : r.history) {
+    f << h.index + 1 << "," << h.from_archive << "," << h.for_gradient << "," << h.ok << "," << h.feasible << ","
+      << csv_number(h.objective) << "," << csv_number(h.max_violation);
+    for (std::size_t i = 0; i < r.variable_names.size(); ++i) f << "," << (i < h.x.size() ? csv_number(h.x[i]) : "");
+    for (std::size_t i = 0; i < r.inequality_names.size(); ++i)
+      f << "," << (i < h.inequality.size() ? csv_number(h.inequality[i]) : "");
+    for (const auto& n : metric_names) {
+      auto it = h.metrics.find(n);
+      f << "," << (it == h.metrics.end() ? "" : csv_number(it->second));
+    }
+    f << "," << csv_number(h.wall_time_s) << "," << csv_number(h.elapsed_s) << "," << csv_text(h.message) << "\n";
+  }
+}
+
+// convergence.csv (+ .png): objective of every evaluation, of the feasible ones, best feasible so far.
+std::string write_convergence(const fs::path& dir, const opt::OptimizationResult& r) {
+  const fs::path csv = dir / "convergence.csv", png = dir / "convergence.png";
+  {
+    std::ofstream f = open_out(csv);
+    f << "evaluation,objective,feasible_objective,best_feasible_objective,max_violation\n";
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& h : r.history) {
+      if (h.feasible && h.objective < best) best = h.objective;
+      f << h.index + 1 << "," << (h.ok && std::isfinite(h.objective) ? format_number(h.objective) : "") << ","
+        << (h.feasible ? format_number(h.objective) : "") << "," << (std::isfinite(best) ? format_number(best) : "")
+        << "," << (std::isfinite(h.max_violation) ? format_number(h.max_violation) : "") << "\n";
+    }
+  }
+  Gnuplot gp;
+  if (!gp.available()) return "convergence plot skipped: gnuplot not found (data in " + csv.string() + ")";
+  XYLinesPlot p;
+  p.csv_path = fs::absolute(csv).string();
+  p.png_path = fs::absolute(png).string();
+  p.labels = {"convergence: " + r.algorithm + " on " + r.problem_name, "evaluation", "objective"};
+  p.series = {{1, 2, "every evaluation", "points"}, {1, 3, "feasible", "points"}, {1, 4, "best feasible so far", "steps"}};
+  const PlotStatus s = gp.xy_lines(p);
+  if (s.ran()) return "wrote " + png.string();
+  return "convergence plot " + s.message + " (data in " + csv.string() + ")";
+}
+
+void write_best_profile(const fs::path& path, const StartupProfileProblem& problem, const opt::OptimizationResult& r,
+                        const std::string& config) {
+  SimulationSetup setup = problem.settings().study.setup;
+  setup.profile = problem.profile_at(r.x);
+  std::ofstream f = open_out(path);
+  f << "# Best startup profile of `abuopt optimize " << config << "` (" << r.algorithm << ", "
+    << r.evaluations << " evaluations, " << to_string(r.reason) << ").\n"
+    << "# " << vector_text(problem.variables(), r.x) << "; objective " << format_number(r.objective)
+    << (r.feasible ? " (feasible)" : " (NOT feasible)") << "\n"
+    << "# Run it: abuopt simulate " << path.string() << "   (or add a montecarlo section for abuopt montecarlo)\n"
+    << to_yaml(setup);
+}
+
+struct Row {
+  std::string label;
+  opt::Evaluation e;
+};
+
+std::string metric_cell(const opt::Evaluation& e, const std::string& key, int width, int precision = 3) {
+  std::ostringstream os;
+  auto it = e.metrics.find(key);
+  if (it == e.metrics.end() || !std::isfinite(it->second))
+    os << std::setw(width) << "-";
+  else
+    os << std::setw(width) << std::fixed << std::setprecision(precision) << it->second;
+  return os.str();
+}
+
+std::string comparison_table(const std::vector<Row>& rows) {
+  std::ostringstream os;
+  os << std::left << std::setw(34) << "  design, sample" << std::right << std::setw(10) << "objective" << std::setw(10)
+     << "mean|Ir|" << std::setw(10) << "mean Irx" << std::setw(9) << "%MI|Ir|" << std::setw(8) << "%MI Irx"
+     << std::setw(7) << "%LC" << std::setw(9) << "amp[mm]" << std::setw(8) << "T[s]" << std::setw(7) << "failed"
+     << "\n";
+  for (const auto& r : rows) {
+    os << std::left << std::setw(34) << ("  " + r.label) << std::right;
+    if (std::isfinite(r.e.objective))
+      os << std::setw(10) << std::fixed << std::setprecision(4) << r.e.objective;
+    else
+      os << std::setw(10) << "failed";
+    os << metric_cell(r.e, "ir_magnitude_mean", 10) << metric_cell(r.e, "ir_x_mean", 10)
+       << metric_cell(r.e, "pct_mi_magnitude", 9, 2) << metric_cell(r.e, "pct_mi_x", 8, 2)
+       << metric_cell(r.e, "pct_lc", 7, 2) << metric_cell(r.e, "amplitude_max_mm", 9) << metric_cell(r.e, "startup_time_s", 8, 2)
+       << metric_cell(r.e, "failed_runs", 7, 0) << "\n";
+  }
+  os << "  (I_r in 1e-7 kg m; amp = max over runs of the peak amplitude; T = startup time)\n";
+  return os.str();
+}
+
+int run_optimize(const OptimizeArgs& a) {
+  LoadedConfig cfg = load_config(a);
+  StartupProfileProblem problem(cfg.settings);
+  const auto& st = problem.settings();
+  const std::vector<opt::Variable> vars = problem.variables();
+  const std::vector<std::string> g_names = problem.inequality_names();
+
+  const fs::path out = a.out.empty() ? fs::path("results") / fs::path(a.config).stem() : fs::path(a.out);
+  std::error_code ec;
+  fs::create_directories(out, ec);
+  if (ec) throw ConfigError("--out", out.string(), "cannot be created (" + ec.message() + ")");
+  const std::string id = problem.identity();
+  opt::EvaluationArchive archive((out / "archive.sqlite").string(), id);
+  opt::ArchivedProblem archived(problem, archive);
+  cfg.sao.archive = &archive;
+
+  // Progress to stdout, or to stderr with --json (stdout then holds the JSON alone).
+  std::ostream& log = a.json ? std::cerr : std::cout;
+  const long stored = archive.count();
+  log << "optimize " << a.config << ": problem " << id << ", " << vars.size() << " variables, "
+      << g_names.size() << " constraints, algorithm " << cfg.options.algorithm << ", budget "
+      << cfg.options.max_evaluations << " evaluations\n"
+      << "  Monte Carlo: " << st.study.runs << " runs per evaluation"
+      << (st.objective.robust_friction_mu.empty()
+              ? std::string()
+              : " x " + std::to_string(st.objective.robust_friction_mu.size()) + " friction values")
+      << ", design " << to_string(st.study.design.kind) << ", seed " << st.study.seed << " (same for every design)\n"
+      << "  archive " << (out / "archive.sqlite").string() << ": " << stored << " stored evaluations of this problem"
+      << (stored ? " (resuming: repeats are answered from it)" : "") << "\n";
+  for (std::size_t i = 0; i < vars.size(); ++i)
+    log << "  " << vars[i].name << " in [" << format_number(vars[i].lower) << ", " << format_number(vars[i].upper)
+        << "], x0 " << format_number(problem.initial_point()[i]) << "\n";
+
+  const opt::EvaluationCallback progress = [&](const opt::Progress& p) {
+    const auto& r = p.last;
+    std::ostringstream os;
+    os << "eval " << std::setw(4) << p.evaluations << "  " << vector_text(vars, r.x) << "  f=";
+    if (r.ok)
+      os << std::setprecision(6) << r.objective;
+    else
+      os << "FAILED (" << r.message << ")";
+    os << "  viol=" << std::setprecision(3) << r.max_violation << "  best=";
+    if (p.have_feasible)
+      os << std::setprecision(6) << p.best_objective;
+    else
+      os << "none";
+    os << (r.from_archive ? "  [archive]" : "  [computed " + format_number(std::round(r.wall_time_s * 10) / 10) + " s]");
+    if (r.for_gradient) os << " [fd]";
+    log << os.str() << "\n" << std::flush;
+    return true;
+  };
+
+  opt::OptimizationResult r = opt::minimize_any(archived, cfg.options, cfg.sao, {}, progress);
+  log << "\n" << r.brief_report() << "\n";
+  if (!r.message.empty()) log << "  " << r.message << "\n";
+
+  nlohmann::json j;
+  j["config"] = a.config;
+  j["problem_id"] = id;
+  j["out"] = out.string();
+  j["algorithm"] = r.algorithm;
+  j["reason"] = to_string(r.reason);
+  j["message"] = r.message;
+  j["success"] = r.success();
+  j["evaluations"] = r.evaluations;
+  j["archive_hits"] = r.archive_hits;
+  j["computed_evaluations"] = r.evaluations - r.archive_hits;
+  j["failed_evaluations"] = r.failed_evaluations;
+  j["gradient_evaluations"] = r.gradient_evaluations;
+  j["wall_time_s"] = r.wall_time_s;
+  nlohmann::json jv = nlohmann::json::array();
+  for (std::size_t i = 0; i < vars.size(); ++i)
+    jv.push_back({{"name", vars[i].name},
+                  {"lower", vars[i].lower},
+                  {"upper", vars[i].upper},
+                  {"scale", vars[i].scale},
+                  {"x0", problem.initial_point()[i]}});
+  j["variables"] = jv;
+  j["constraints"] = g_names;
+  j["montecarlo"] = {{"runs", st.study.runs},
+                     {"design", to_string(st.study.design.kind)},
+                     {"seed", st.study.seed},
+                     {"robust_friction_mu", st.objective.robust_friction_mu}};
+  j["objective"] = {{"kind", to_string(st.objective.kind)}, {"definition", to_string(st.objective.definition)}};
+
+  const bool have_best = !r.x.empty();
+  if (have_best) {
+    nlohmann::json bx = nlohmann::json::object();
+    for (std::size_t i = 0; i < vars.size(); ++i) bx[vars[i].name] = r.x[i];
+    nlohmann::json bg = nlohmann::json::object();
+    for (std::size_t i = 0; i < g_names.size() && i < r.inequality.size(); ++i) bg[g_names[i]] = r.inequality[i];
+    j["best"] = {{"x", bx},
+                 {"objective", r.objective},
+                 {"feasible", r.feasible},
+                 {"max_violation", r.max_violation},
+                 {"constraints", bg},
+                 {"metrics", r.metrics},
+                 {"profile", profile_json(problem.profile_at(r.x))}};
+    log << "best design: " << vector_text(vars, r.x) << "\n  profile " << profile_text(problem.profile_at(r.x))
+        << "\n  objective " << format_number(r.objective) << (r.feasible ? " (feasible)" : " (NOT feasible)") << "\n";
+  } else {
+    log << "no evaluation finished: nothing to report\n";
+  }
+
+  // Files first (a Ctrl-C during the validation below still leaves them), result.json again after it.
+  write_history_csv(out / "history.csv", r);
+  const std::string plot_message = write_convergence(out, r);
+  if (have_best) write_best_profile(out / "best_profile.yaml", problem, r, a.config);
+  j["files"] = {{"history", (out / "history.csv").string()},
+                {"convergence_csv", (out / "convergence.csv").string()},
+                {"archive", (out / "archive.sqlite").string()}};
+  if (have_best) j["files"]["best_profile"] = (out / "best_profile.yaml").string();
+  j["convergence_plot"] = plot_message;
+  const fs::path result_json = out / "result.json";
+  auto write_json = [&] { open_out(result_json) << j.dump(2) << "\n"; };
+  write_json();
+
+  const bool interrupted = r.reason == opt::TerminationReason::interrupted;
+  if (have_best && st.validation.enabled && !interrupted) {
+    const auto& v = st.validation;
+    log << "\nvalidation: " << v.runs << " fresh initial conditions (" << to_string(v.design) << ", seed " << v.seed
+        << ") for the best design and for the report's final profile ...\n"
+        << std::flush;
+    const StartupProfile best = problem.profile_at(r.x), report = StartupProfile::report_final();
+    opt::Evaluation best_in;
+    best_in.objective = r.objective;
+    best_in.inequality = r.inequality;
+    best_in.metrics = r.metrics;
+    const std::vector<Row> rows = {
+        {"best, in-sample (" + std::to_string(st.study.runs) + ")", best_in},
+        {"best, out-of-sample (" + std::to_string(v.runs) + ")", problem.evaluate_out_of_sample(best)},
+        {"report profile, in-sample", problem.evaluate_profile(report)},
+        {"report profile, out-of-sample", problem.evaluate_out_of_sample(report)},
+    };
+    log << comparison_table(rows);
+    log << "  report profile: " << profile_text(report) << "\n";
+    j["validation"] = {{"runs", v.runs},
+                       {"design", to_string(v.design)},
+                       {"seed", v.seed},
+                       {"best", {{"in_sample", evaluation_json(rows[0].e, g_names)},
+                                 {"out_of_sample", evaluation_json(rows[1].e, g_names)}}},
+                       {"report_profile", {{"profile", profile_json(report)},
+                                           {"in_sample", evaluation_json(rows[2].e, g_names)},
+                                           {"out_of_sample", evaluation_json(rows[3].e, g_names)}}}};
+    write_json();
+  } else if (interrupted) {
+    log << "interrupted: the best design so far is written; rerun the same command to resume from the archive\n";
+  }
+
+  log << "wrote " << (out / "history.csv").string() << ", " << result_json.string()
+      << (have_best ? ", " + (out / "best_profile.yaml").string() : std::string()) << "\n"
+      << plot_message << "\n";
+  if (a.json) std::cout << j.dump(2) << "\n";
+  if (interrupted) return 130;
+  return r.has_feasible_point() ? 0 : 3;
+}
+
+}  // namespace
+
+void register_optimize(CLI::App& app) {
+  auto args = std::make_shared<OptimizeArgs>();
+  CLI::App* sub = app.add_subcommand(
+      "optimize",
+      "Optimise a startup profile: segment end frequencies and durations chosen by an optimiser\n"
+      "(COBYLA, BOBYQA, SLSQP, IPOPT, DIRECT_L, SAO, ...), each design evaluated by a Monte Carlo over\n"
+      "the same initial ball angles; constraints on startup time, amplitude and %MI. Every evaluation\n"
+      "is archived in OUT/archive.sqlite: rerunning the same command resumes. At the end the best design\n"
+      "and the report's final profile are evaluated on a fresh, larger set of initial conditions.\n"
+      "Exit status: 0 ok, 2 bad input, 3 no feasible design found, 130 interrupted (Ctrl-C).");
+  sub->add_option("config", args->config,
+                  "YAML config (abu, profile, motor, simulation, montecarlo, design, objective, constraints,\n"
+                  "validation, optimizer, sao); see configs/optimize/ and docs/optimize.md")
+      ->required();
+  sub->add_option("--out", args->out, "output directory (default results/<config stem>)");
+  sub->add_flag("--json", args->json, "print result.json to stdout (progress goes to stderr)");
+  sub->add_option("--max-evaluations", args->max_evaluations, "evaluation budget (overrides optimizer.max_evaluations)");
+  sub->add_option("--threads", args->threads, "Monte Carlo worker threads (0 = all cores; overrides montecarlo.threads)");
+  sub->callback([args] { set_exit_code(run_optimize(*args)); });
+}
+
+}  // namespace abuopt::app

@@ -1,0 +1,185 @@
+#pragma once
+// The startup-profile design problem (spec section 8, report section 4.6): where the optimiser and
+// the ABU model meet.
+//
+//   design vector x  ->  StartupProfile (inclined-sine segments, some values free, some fixed)
+//                    ->  Monte Carlo over initial ball angles (the core engine), once per friction
+//                        value of the robust set (one pass at the nominal friction otherwise)
+//                    ->  objective, inequality constraints g(x) <= 0, metrics.
+//
+// Common random numbers: every design is evaluated on the SAME initial conditions (the
+// `montecarlo` design and seed are fixed), so differences between designs are not masked by
+// sampling noise, and the same x always gives bit-identical values (an archive can answer repeats).
+//
+// Objective (minimised), with I_r in units of 1e-7 kg m (as the report's tables) and %MI in percent,
+// for the chosen definition of I_r (magnitude |I_r| by default, or the report's I_r,x):
+//   mean:      mean I_r
+//   pct_mi:    %MI (piecewise constant in x: a step of 100/runs; prefer mean or weighted)
+//   weighted:  w_mean * mean I_r + w_pct_mi * %MI
+// Robust (objective.robust.friction_mu = [mu_1..mu_K]): the objective is the average over k of the
+// objective of the Monte Carlo run with friction fixed to mu_k (same initial conditions for every
+// k); constraints and metrics use the pooled statistics of all K x runs runs (pooled %MI = average
+// %MI; pooled amplitude max = max over every run).
+//
+// Constraints (each optional), in relative form so that one tolerance suits all:
+//   startup_time:  T_profile / max_startup_time_s - 1 <= 0      (T_profile = sum of durations)
+//   amplitude:     A / max_amplitude_mm - 1 <= 0, A = max over runs of the peak amplitude
+//                  (amplitude: max, default) or the mean over runs of it (amplitude: mean)
+//   pct_mi:        %MI / max_pct_mi - 1 <= 0                    (definition of the objective)
+// With constraints.penalty_weight = w > 0 the problem declares NO constraints (for bound-only
+// optimisers) and minimises objective + w * sum_i max(0, g_i) instead (exact L1 penalty).
+//
+// A failed evaluation (opt::Evaluation::failed, never an exception): a profile with a duration
+// that is not > 0 (never simulated), every run of a pass failing, or more failed runs than
+// objective.max_failed_fraction.
+//
+// Metrics of every evaluation (pooled over the robust set; I_r in 1e-7 kg m):
+//   ir_magnitude_{mean,median,max}, ir_x_{mean,median,max}, pct_mi_magnitude, pct_mi_x, pct_mi
+//   (the constrained/optimised definition), pct_lc, amplitude_max_mm, amplitude_mean_mm,
+//   startup_time_s, end_time_s, runs, failed_runs, mc_wall_time_s; with a robust set also
+//   objective_mu<k>, mu<k> and pct_mi_mu<k> for k = 1..K; with a penalty, g_<name> per constraint.
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "abuopt/common/yaml_reader.hpp"
+#include "abuopt/core/initial_conditions.hpp"
+#include "abuopt/core/monte_carlo.hpp"
+#include "abuopt/core/profile.hpp"
+#include "abuopt/core/simulator.hpp"
+#include "abuopt/optimizer/problem.hpp"
+
+namespace abuopt::problems {
+
+// One value of a segment: fixed, or a free design variable with bounds.
+struct DesignValue {
+  bool free = false;
+  double value = 0.0;   // fixed: the value; free: the starting point x0
+  double lower = 0.0;   // free only
+  double upper = 0.0;   // free only
+  double scale = 0.0;   // free only; 0: upper - lower
+};
+
+struct SegmentDesign {
+  DesignValue end_frequency_hz;  // variable name f<i> (1-based)
+  DesignValue duration_s;        // variable name dt<i>
+};
+
+struct ProfileDesign {
+  double start_frequency_hz = 0.0;
+  std::vector<SegmentDesign> segments;
+};
+
+enum class ObjectiveKind { mean, pct_mi, weighted };
+enum class ImbalanceDefinition { magnitude, report_x };
+enum class AmplitudeStatistic { max, mean };
+std::string to_string(ObjectiveKind k);
+std::string to_string(ImbalanceDefinition d);
+std::string to_string(AmplitudeStatistic a);
+
+struct ObjectiveSettings {
+  ObjectiveKind kind = ObjectiveKind::mean;
+  ImbalanceDefinition definition = ImbalanceDefinition::magnitude;
+  double weight_mean = 1.0;    // weighted: per 1e-7 kg m of mean I_r
+  double weight_pct_mi = 0.0;  // weighted: per percent of %MI
+  // Robust objective: average over these friction coefficients; empty: one pass with the
+  // montecarlo section's friction (nominal abu.friction_mu by default).
+  std::vector<double> robust_friction_mu;
+  // More failed runs than this fraction (pooled) make the evaluation fail.
+  double max_failed_fraction = 0.05;
+};
+
+struct ConstraintSettings {
+  std::optional<double> max_startup_time_s;
+  std::optional<double> max_amplitude_mm;
+  AmplitudeStatistic amplitude = AmplitudeStatistic::max;
+  std::optional<double> max_pct_mi;
+  double penalty_weight = 0.0;  // > 0: constraints folded into the objective (no declared constraints)
+};
+
+// The out-of-sample check of the app: a fresh, larger set of initial conditions.
+struct ValidationSettings {
+  bool enabled = true;
+  InitialConditionKind design = InitialConditionKind::Random;
+  std::size_t grid = 32;    // grid design: points per axis (runs = grid^balls)
+  std::size_t runs = 1024;
+  std::uint64_t seed = 1000003;
+};
+
+struct StartupProfileSettings {
+  // abu, motor, simulation and the profile TEMPLATE (its values fill segment values that the
+  // design leaves out), the initial-condition design, runs, seed and uncertain parameters.
+  MonteCarloStudy study;
+  std::size_t threads = 0;  // Monte Carlo workers (0: all cores); results do not depend on it
+  ProfileDesign design;
+  ObjectiveSettings objective;
+  ConstraintSettings constraints;
+  ValidationSettings validation;
+};
+
+// Reads the sections abu, profile, motor, simulation, montecarlo, design, objective, constraints
+// and validation of `root` (docs/optimize.md lists every key). Leaves the other sections (optimizer,
+// sao) to the caller, who calls root.finish(). Throws ConfigError naming key, value and rule.
+StartupProfileSettings read_startup_profile_settings(YamlReader& root);
+
+// The design section alone (the profile template fills absent segment values).
+ProfileDesign read_profile_design(YamlReader design, const StartupProfile& profile_template);
+
+// Throws ConfigError for an invalid design (no free variable, bounds reversed, x0 outside the
+// bounds, durations not > 0, ...), objective or constraint settings.
+void validate(const StartupProfileSettings& s);
+
+// FNV-1a, 64 bits.
+std::uint64_t fnv1a64(std::string_view text);
+
+class StartupProfileProblem : public opt::Problem {
+ public:
+  explicit StartupProfileProblem(StartupProfileSettings settings);  // validates; throws ConfigError
+
+  std::string name() const override { return "startup_profile"; }
+  std::vector<opt::Variable> variables() const override { return variables_; }
+  std::vector<std::string> inequality_names() const override;
+  opt::Evaluation evaluate(const std::vector<double>& x) override;
+  std::vector<double> initial_point() const override;
+
+  const StartupProfileSettings& settings() const { return settings_; }
+
+  // The mapping x -> profile (fixed values from the design). x must have one entry per variable
+  // (std::invalid_argument otherwise); values are not checked (see evaluate()).
+  StartupProfile profile_at(const std::vector<double>& x) const;
+  // Sum of the durations at x [s].
+  double startup_time_s(const std::vector<double>& x) const;
+
+  // Evaluates any profile exactly as evaluate() does, on the in-sample initial conditions, or on
+  // another set (design kind/grid/count/seed; `seed` also seeds the uncertain parameters).
+  opt::Evaluation evaluate_profile(const StartupProfile& profile) const;
+  opt::Evaluation evaluate_profile(const StartupProfile& profile, const InitialConditionDesign& design,
+                                   std::size_t runs, std::uint64_t seed) const;
+  // The validation set of the settings as (design, runs, seed) for evaluate_profile.
+  opt::Evaluation evaluate_out_of_sample(const StartupProfile& profile) const;
+
+  // Everything that decides the value of evaluate(x) as canonical text: the resolved setup
+  // (to_yaml), the fixed values and the order of the free variables, the Monte Carlo sampling, the
+  // objective and the constraints. Not in it (changing them keeps archived evaluations valid):
+  // bounds, x0, scales, threads, validation, optimizer settings.
+  std::string identity_text() const;
+  // "startup_profile-<16 hex digits of fnv1a64(identity_text())>": the archive's problem id.
+  std::string identity() const;
+
+ private:
+  StartupProfileSettings settings_;
+  std::vector<opt::Variable> variables_;
+  std::vector<double> x0_;
+  // For each variable: segment index and whether it is the duration.
+  struct Slot {
+    std::size_t segment;
+    bool duration;
+  };
+  std::vector<Slot> slots_;
+  std::vector<std::string> constraint_names_;
+};
+
+}  // namespace abuopt::problems
