@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   abuopt::app::register_montecarlo(app);
   abuopt::app::register_eqset(app);
   abuopt::app::register_compare(app);
+  abuopt::app::register_optimize(app);
 
   try {
     app.parse(argc, argv);

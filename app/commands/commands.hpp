@@ -13,5 +13,6 @@ void register_simulate(CLI::App& app);
 void register_montecarlo(CLI::App& app);
 void register_eqset(CLI::App& app);
 void register_compare(CLI::App& app);
+void register_optimize(CLI::App& app);
 
 }  // namespace abuopt::app
