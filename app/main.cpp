@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   abuopt::app::register_simulate(app);
   abuopt::app::register_montecarlo(app);
   abuopt::app::register_eqset(app);
+  abuopt::app::register_reproduce(app);
   abuopt::app::register_compare(app);
   abuopt::app::register_optimize(app);
 

@@ -12,6 +12,7 @@ int exit_code();
 void register_simulate(CLI::App& app);
 void register_montecarlo(CLI::App& app);
 void register_eqset(CLI::App& app);
+void register_reproduce(CLI::App& app);
 void register_compare(CLI::App& app);
 void register_optimize(CLI::App& app);
 
