@@ -1,0 +1,322 @@
+// The startup-profile problem: the design vector -> profile mapping (free/fixed values, names,
+// bounds, scales), the objective kinds and robust averaging against statistics computed directly
+// by the core Monte Carlo engine, the constraint values, the penalty form, the guard against
+// durations <= 0, common random numbers, the identity hash, and config errors.
+// Tiny Monte Carlo studies (4 runs, profiles of ~0.5 s) keep it fast.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <string>
+
+#include "abuopt/common/config_error.hpp"
+#include "abuopt/core/monte_carlo.hpp"
+#include "abuopt/core/monte_carlo_stats.hpp"
+#include "abuopt/problems/startup_profile_problem.hpp"
+
+namespace {
+
+using namespace abuopt;
+using problems::StartupProfileProblem;
+using problems::StartupProfileSettings;
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "<no error>";
+}
+
+StartupProfileSettings settings_from(const std::string& yaml) {
+  YamlReader root = YamlReader::load_string(yaml);
+  StartupProfileSettings s = problems::read_startup_profile_settings(root);
+  root.finish();
+  return s;
+}
+
+// The report's three-step profile as template; five free variables as in configs/optimize/.
+const std::string kThreeStep = R"(
+profile:
+  segments:
+    - {end_frequency_hz: 25.0, duration_s: 1.0}
+    - {end_frequency_hz: 29.5, duration_s: 10.0}
+    - {end_frequency_hz: 100.0, duration_s: 8.0}
+montecarlo: {design: grid, grid: 2, threads: 1}
+design:
+  segments:
+    - end_frequency_hz: {min: 15, max: 28, x0: 25}
+      duration_s: {min: 0.3, max: 3, x0: 1, scale: 0.5}
+    - end_frequency_hz: {min: 28, max: 32}
+      duration_s: {min: 1, max: 12, x0: 10}
+    - end_frequency_hz: 100
+      duration_s: {min: 1, max: 10, x0: 8}
+constraints: {max_startup_time_s: 20, max_pct_mi: 5}
+)";
+
+// A short one-segment study: 0 -> f1 Hz in dt1 s (end time 2 dt1), 2 x 2 grid of initial angles.
+std::string tiny(const std::string& objective, const std::string& constraints = "",
+                 const std::string& montecarlo_extra = "") {
+  return "montecarlo: {design: grid, grid: 2, threads: 1" + montecarlo_extra +
+         "}\n"
+         "design:\n"
+         "  segments:\n"
+         "    - end_frequency_hz: {min: 20, max: 40, x0: 35}\n"
+         "      duration_s: {min: 0.2, max: 1.0, x0: 0.4}\n"
+         "objective: " + objective + "\n" +
+         (constraints.empty() ? std::string() : "constraints: " + constraints + "\n");
+}
+
+// Statistics of the same study computed directly by the engine (independent of the problem).
+MonteCarloStats direct_stats(const StartupProfileSettings& s, const StartupProfile& p, std::optional<double> mu = {}) {
+  MonteCarloStudy st = s.study;
+  st.setup.profile = p;
+  if (mu) {
+    st.uncertain.friction.sampling = FrictionSampling::Fixed;
+    st.uncertain.friction.value = *mu;
+  }
+  ThreadPoolRunner runner(1);
+  return compute_statistics(run_monte_carlo(st, runner));
+}
+
+}  // namespace
+
+TEST(StartupProfileProblem, DesignVectorMapsToProfileWithNamesBoundsAndFixedValues) {
+  StartupProfileProblem p(settings_from(kThreeStep));
+  const auto vars = p.variables();
+  ASSERT_EQ(vars.size(), 5u);
+  const char* names[] = {"f1", "dt1", "f2", "dt2", "dt3"};
+  for (std::size_t i = 0; i < 5; ++i) EXPECT_EQ(vars[i].name, names[i]);
+  EXPECT_EQ(vars[0].lower, 15);
+  EXPECT_EQ(vars[0].upper, 28);
+  EXPECT_EQ(vars[0].scale, 13);   // default: upper - lower
+  EXPECT_EQ(vars[1].scale, 0.5);  // given
+  EXPECT_EQ(vars[3].lower, 1);
+  EXPECT_EQ(vars[3].upper, 12);
+  // x0: given, else the template's value when inside the bounds (f2 = 29.5).
+  EXPECT_EQ(p.initial_point(), (std::vector<double>{25, 1, 29.5, 10, 8}));
+  EXPECT_EQ(p.inequality_names(), (std::vector<std::string>{"startup_time", "pct_mi"}));
+
+  const StartupProfile prof = p.profile_at({20, 0.5, 30, 7, 4});
+  ASSERT_EQ(prof.segments().size(), 3u);
+  EXPECT_EQ(prof.segments()[0].end_frequency_hz, 20);
+  EXPECT_EQ(prof.segments()[0].duration_s, 0.5);
+  EXPECT_EQ(prof.segments()[1].end_frequency_hz, 30);
+  EXPECT_EQ(prof.segments()[1].duration_s, 7);
+  EXPECT_EQ(prof.segments()[2].end_frequency_hz, 100);  // fixed
+  EXPECT_EQ(prof.segments()[2].duration_s, 4);
+  EXPECT_EQ(prof.start_frequency_hz(), 0);
+  EXPECT_DOUBLE_EQ(p.startup_time_s({20, 0.5, 30, 7, 4}), 11.5);
+  EXPECT_THROW(p.profile_at({1, 2}), std::invalid_argument);
+}
+
+TEST(StartupProfileProblem, AbsentSegmentValuesComeFromTheTemplate) {
+  StartupProfileProblem p(settings_from(R"(
+profile:
+  start_frequency_hz: 2
+  segments: [{end_frequency_hz: 25, duration_s: 1}, {end_frequency_hz: 29.5, duration_s: 10}]
+design:
+  segments:
+    - {duration_s: {min: 0.5, max: 2}}
+    - {}
+)"));
+  ASSERT_EQ(p.variables().size(), 1u);
+  EXPECT_EQ(p.variables()[0].name, "dt1");
+  EXPECT_EQ(p.initial_point(), std::vector<double>{1});  // template value, inside the bounds
+  const StartupProfile prof = p.profile_at({1.5});
+  EXPECT_EQ(prof.start_frequency_hz(), 2);
+  EXPECT_EQ(prof.segments()[0].end_frequency_hz, 25);
+  EXPECT_EQ(prof.segments()[1].end_frequency_hz, 29.5);
+  EXPECT_EQ(prof.segments()[1].duration_s, 10);
+  EXPECT_TRUE(p.inequality_names().empty());
+}
+
+TEST(StartupProfileProblem, ObjectiveKindsMatchTheEngineStatistics) {
+  const std::vector<double> x = {35, 0.4};
+  StartupProfileProblem mean(settings_from(tiny("{kind: mean}")));
+  const MonteCarloStats st = direct_stats(mean.settings(), mean.profile_at(x));
+  ASSERT_EQ(st.runs, 4u);
+  ASSERT_EQ(st.ok, 4u);
+
+  const opt::Evaluation e = mean.evaluate(x);
+  ASSERT_TRUE(e.ok) << e.message;
+  EXPECT_DOUBLE_EQ(e.objective, st.magnitude.mean / 1e-7);
+  EXPECT_DOUBLE_EQ(e.metrics.at("ir_magnitude_mean"), st.magnitude.mean / 1e-7);
+  EXPECT_DOUBLE_EQ(e.metrics.at("ir_x_max"), st.report_x.max / 1e-7);
+  EXPECT_DOUBLE_EQ(e.metrics.at("pct_mi_x"), st.report_x.pct_mi);
+  EXPECT_DOUBLE_EQ(e.metrics.at("amplitude_max_mm"), st.amplitude_max_mm);
+  EXPECT_EQ(e.metrics.at("runs"), 4);
+  EXPECT_EQ(e.metrics.at("failed_runs"), 0);
+  EXPECT_DOUBLE_EQ(e.metrics.at("startup_time_s"), 0.4);
+  EXPECT_DOUBLE_EQ(e.metrics.at("end_time_s"), 0.8);  // twice the profile (report's rule)
+  // The mean by hand from the per-run outcomes.
+  MonteCarloStudy study = mean.settings().study;
+  study.setup.profile = mean.profile_at(x);
+  ThreadPoolRunner runner(1);
+  double sum = 0;
+  for (const auto& s : run_monte_carlo(study, runner).samples) sum += s.outcome.residual_imbalance_kgm;
+  EXPECT_NEAR(e.objective, sum / 4 / 1e-7, 1e-9);
+
+  StartupProfileProblem rx(settings_from(tiny("{kind: mean, definition: report_x}")));
+  EXPECT_DOUBLE_EQ(rx.evaluate(x).objective, st.report_x.mean / 1e-7);
+  StartupProfileProblem mi(settings_from(tiny("{kind: pct_mi}")));
+  EXPECT_DOUBLE_EQ(mi.evaluate(x).objective, st.magnitude.pct_mi);
+  StartupProfileProblem w(settings_from(tiny("{kind: weighted, weights: {mean: 2, pct_mi: 0.5}}")));
+  EXPECT_DOUBLE_EQ(w.evaluate(x).objective, 2 * st.magnitude.mean / 1e-7 + 0.5 * st.magnitude.pct_mi);
+}
+
+TEST(StartupProfileProblem, RobustObjectiveIsTheMeanOverFrictionValues) {
+  const std::vector<double> x = {35, 0.4};
+  StartupProfileProblem robust(settings_from(tiny("{kind: weighted, weights: {mean: 1, pct_mi: 1}, robust: {friction_mu: [0.02, 0.04]}}")));
+  const opt::Evaluation e = robust.evaluate(x);
+  ASSERT_TRUE(e.ok) << e.message;
+  const MonteCarloStats a = direct_stats(robust.settings(), robust.profile_at(x), 0.02);
+  const MonteCarloStats b = direct_stats(robust.settings(), robust.profile_at(x), 0.04);
+  const double fa = a.magnitude.mean / 1e-7 + a.magnitude.pct_mi, fb = b.magnitude.mean / 1e-7 + b.magnitude.pct_mi;
+  EXPECT_NEAR(e.objective, 0.5 * (fa + fb), 1e-12);
+  EXPECT_DOUBLE_EQ(e.metrics.at("objective_mu1"), fa);
+  EXPECT_DOUBLE_EQ(e.metrics.at("objective_mu2"), fb);
+  EXPECT_EQ(e.metrics.at("mu2"), 0.04);
+  // Pooled statistics over both passes: 8 runs, %MI the average of the two.
+  EXPECT_EQ(e.metrics.at("runs"), 8);
+  EXPECT_NEAR(e.metrics.at("pct_mi"), 0.5 * (a.magnitude.pct_mi + b.magnitude.pct_mi), 1e-12);
+  EXPECT_DOUBLE_EQ(e.metrics.at("amplitude_max_mm"), std::max(a.amplitude_max_mm, b.amplitude_max_mm));
+  // The friction actually changes the outcome (otherwise the test proves nothing).
+  EXPECT_NE(a.magnitude.mean, b.magnitude.mean);
+}
+
+TEST(StartupProfileProblem, ConstraintValuesAreRelativeToTheirBounds) {
+  const std::vector<double> x = {35, 0.4};
+  StartupProfileProblem p(settings_from(tiny("{kind: mean}", "{max_startup_time_s: 0.5, max_amplitude_mm: 2, max_pct_mi: 40}")));
+  ASSERT_EQ(p.inequality_names(), (std::vector<std::string>{"startup_time", "amplitude", "pct_mi"}));
+  const opt::Evaluation e = p.evaluate(x);
+  ASSERT_TRUE(e.ok) << e.message;
+  ASSERT_EQ(e.inequality.size(), 3u);
+  EXPECT_DOUBLE_EQ(e.inequality[0], 0.4 / 0.5 - 1.0);  // startup time exactly
+  EXPECT_DOUBLE_EQ(e.inequality[1], e.metrics.at("amplitude_max_mm") / 2 - 1.0);
+  EXPECT_DOUBLE_EQ(e.inequality[2], e.metrics.at("pct_mi_magnitude") / 40 - 1.0);
+  // %MI is a multiple of 100/4 with 4 runs.
+  EXPECT_DOUBLE_EQ(std::fmod(e.metrics.at("pct_mi"), 25.0), 0.0);
+
+  StartupProfileProblem mean_amp(
+      settings_from(tiny("{kind: mean}", "{max_amplitude_mm: 2, amplitude: mean}")));
+  const opt::Evaluation m = mean_amp.evaluate(x);
+  EXPECT_DOUBLE_EQ(m.inequality[0], m.metrics.at("amplitude_mean_mm") / 2 - 1.0);
+  EXPECT_LE(m.metrics.at("amplitude_mean_mm"), m.metrics.at("amplitude_max_mm"));
+
+  // Penalty form: no declared constraints, objective + w * sum max(0, g).
+  StartupProfileProblem pen(
+      settings_from(tiny("{kind: mean}", "{max_startup_time_s: 0.3, max_pct_mi: 40, penalty_weight: 10}")));
+  EXPECT_TRUE(pen.inequality_names().empty());
+  const opt::Evaluation q = pen.evaluate(x);
+  EXPECT_TRUE(q.inequality.empty());
+  const double g_time = 0.4 / 0.3 - 1.0, g_mi = q.metrics.at("pct_mi") / 40 - 1.0;
+  EXPECT_DOUBLE_EQ(q.metrics.at("g_startup_time"), g_time);
+  EXPECT_NEAR(q.objective, e.objective + 10 * (std::max(0.0, g_time) + std::max(0.0, g_mi)), 1e-12);
+}
+
+TEST(StartupProfileProblem, CommonRandomNumbersGiveIdenticalRepeats) {
+  StartupProfileProblem p(settings_from(tiny("{kind: mean}")));
+  const opt::Evaluation a = p.evaluate({35, 0.4});
+  const opt::Evaluation b = p.evaluate({35, 0.4});
+  EXPECT_EQ(a.objective, b.objective);
+  // Threads do not matter.
+  StartupProfileSettings s = p.settings();
+  s.threads = 2;
+  StartupProfileProblem q(s);
+  EXPECT_EQ(q.evaluate({35, 0.4}).objective, a.objective);
+}
+
+TEST(StartupProfileProblem, DurationsNotPositiveAreNeverSimulated) {
+  StartupProfileProblem p(settings_from(tiny("{kind: mean}")));
+  const opt::Evaluation e = p.evaluate_profile(StartupProfile({{30, 0.0}}));
+  EXPECT_FALSE(e.ok);
+  EXPECT_NE(e.message.find("not simulated"), std::string::npos) << e.message;
+  EXPECT_FALSE(p.evaluate_profile(StartupProfile({{30, 0.5}, {40, -1}})).ok);
+  EXPECT_FALSE(p.evaluate_profile(StartupProfile({{30, std::nan("")}})).ok);
+}
+
+TEST(StartupProfileProblem, OutOfSampleUsesTheValidationSet) {
+  StartupProfileSettings s = settings_from(tiny("{kind: mean}") + "validation: {runs: 6, design: lhs, seed: 3}\n");
+  StartupProfileProblem p(s);
+  EXPECT_EQ(p.settings().validation.runs, 6u);
+  const opt::Evaluation e = p.evaluate_out_of_sample(p.profile_at({35, 0.4}));
+  ASSERT_TRUE(e.ok);
+  EXPECT_EQ(e.metrics.at("runs"), 6);
+  // Default validation: 1024 random runs, seed = montecarlo seed + 1.
+  StartupProfileProblem d(settings_from(tiny("{kind: mean}", "", ", seed: 5")));
+  EXPECT_EQ(d.settings().validation.runs, 1024u);
+  EXPECT_EQ(d.settings().validation.seed, 6u);
+  EXPECT_EQ(d.settings().validation.design, InitialConditionKind::Random);
+}
+
+TEST(StartupProfileProblem, IdentityChangesWithWhatDecidesTheValues) {
+  const std::string base = StartupProfileProblem(settings_from(kThreeStep)).identity();
+  EXPECT_EQ(base.rfind("startup_profile-", 0), 0u);
+  EXPECT_EQ(base.size(), std::string("startup_profile-").size() + 16);
+  EXPECT_EQ(StartupProfileProblem(settings_from(kThreeStep)).identity(), base);  // deterministic
+
+  auto changed = [&](const std::string& from, const std::string& to) {
+    std::string y = kThreeStep;
+    const auto at = y.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    y.replace(at, from.size(), to);
+    return StartupProfileProblem(settings_from(y)).identity();
+  };
+  // Values that change evaluate(x): a new identity.
+  EXPECT_NE(changed("grid: 2,", "grid: 2, seed: 1,"), base);                      // Monte Carlo seed
+  EXPECT_NE(changed("design: grid, grid: 2", "design: lhs, runs: 4"), base);      // sampling
+  EXPECT_NE(changed("end_frequency_hz: 100\n", "end_frequency_hz: 90\n"), base);  // a fixed value
+  EXPECT_NE(changed("max_pct_mi: 5", "max_pct_mi: 4"), base);                     // a constraint
+  EXPECT_NE(changed("montecarlo:", "abu: {friction_mu: 0.03}\nmontecarlo:"), base);
+  EXPECT_NE(changed("montecarlo:", "objective: {definition: report_x}\nmontecarlo:"), base);
+  EXPECT_NE(changed("montecarlo:", "simulation: {rtol: 1e-7}\nmontecarlo:"), base);
+  // Bounds, x0, threads and validation do not change any value: same identity (archive reused).
+  EXPECT_EQ(changed("{min: 15, max: 28, x0: 25}", "{min: 14, max: 28, x0: 20}"), base);
+  EXPECT_EQ(changed("threads: 1", "threads: 2"), base);
+  EXPECT_EQ(changed("montecarlo:", "validation: {runs: 64}\nmontecarlo:"), base);
+
+  EXPECT_NE(problems::fnv1a64("a"), problems::fnv1a64("b"));
+  EXPECT_EQ(problems::fnv1a64(""), 14695981039346656037ull);  // FNV-1a offset basis
+  EXPECT_EQ(problems::fnv1a64("a"), 0xaf63dc4c8601ec8cull);   // published test vector
+}
+
+TEST(StartupProfileProblem, ConfigErrorsNameKeyValueAndRule) {
+  auto err = [](const std::string& yaml) { return error_of([&] { settings_from(yaml); }); };
+  const std::string head = "montecarlo: {design: grid, grid: 2}\n";
+  EXPECT_EQ(err(head + "design: {segments: [{end_frequency_hz: {min: 28, max: 15}, duration_s: 1}]}\n"),
+            "design.segments[0].end_frequency_hz.min = 28: must be below design.segments[0].end_frequency_hz.max = 15 "
+            "(bounds reversed or equal)");
+  EXPECT_EQ(err(head + "design: {segments: [{end_frequency_hz: {min: 15, max: 28, x0: 30}, duration_s: 1}]}\n"),
+            "design.segments[0].end_frequency_hz.x0 = 30: must be in [15, 28] (the bounds)");
+  EXPECT_EQ(err(head + "design: {segments: [{end_frequency_hz: 30, duration_s: {min: 0, max: 2}}]}\n"),
+            "design.segments[0].duration_s.min = 0: must be > 0 (a profile with a duration <= 0 is never simulated)");
+  EXPECT_EQ(err(head + "design: {segments: [{end_frequency_hz: 30, duration_s: 1}]}\n"),
+            "design.segments = 1 segments, all values fixed: no free variable: give at least one value as "
+            "{min: ..., max: ...}");
+  EXPECT_EQ(err(head + "design: {segments: [{end_frequency_hz: 30, duration_s: -1}, {duration_s: {min: 1, max: 2}}]}\n"),
+            "design.segments[0].duration_s = -1: must be > 0 (a profile with a duration <= 0 is never simulated)");
+  EXPECT_EQ(err(head + "design: {segments: [{end_frequency_hz: 30, duraton_s: {min: 1, max: 2}}]}\n"),
+            "design.segments[0].duraton_s = {min: 1, max: 2}: unknown key (misspelt, or not valid here)");
+  EXPECT_EQ(err(head + "profile: {segments: [{end_frequency_hz: 25, duration_s: 1}]}\n"
+                       "design: {segments: [{duration_s: {min: 1, max: 2}}, {duration_s: 3}]}\n"),
+            "design.segments[1].end_frequency_hz = <missing>: is required (the profile template has no segment 1)");
+  EXPECT_EQ(err(head), "design = <missing>: is required (design: {segments: [...]} with at least one free {min, max} value)");
+  const std::string design = "design: {segments: [{end_frequency_hz: 30, duration_s: {min: 1, max: 2}}]}\n";
+  EXPECT_EQ(err(head + design + "objective: {kind: median}\n"),
+            "objective.kind = median: must be one of: mean, pct_mi, weighted");
+  EXPECT_EQ(err(head + design + "objective: {kind: mean, weights: {mean: 1}}\n"),
+            "objective.weights = {mean: 1}: is only used with objective.kind: weighted");
+  EXPECT_EQ(err(head + design + "objective: {kind: weighted, weights: {mean: 0, pct_mi: 0}}\n"),
+            "objective.weights = {mean: 0, pct_mi: 0}: at least one weight must be > 0");
+  EXPECT_EQ(err("montecarlo: {design: grid, grid: 2, friction: {fixed: 0.03}}\n" + design +
+                "objective: {robust: {friction_mu: [0.02, 0.04]}}\n"),
+            "objective.robust.friction_mu = [0.02, 0.04]: cannot be combined with montecarlo.friction (give the "
+            "friction values in one place)");
+  EXPECT_EQ(err(head + design + "constraints: {max_pct_mi: -1}\n"), "constraints.max_pct_mi = -1: must be in [1e-09, 100]");
+  EXPECT_EQ(err(head + design + "constraints: {max_startup: 20}\n"),
+            "constraints.max_startup = 20: unknown key (misspelt, or not valid here)");
+  EXPECT_EQ(err(head + design + "validation: {design: grid, grid: 4, runs: 10}\n"),
+            "validation.runs = 10: must equal validation.grid^balls = 16 with the grid design");
+}
