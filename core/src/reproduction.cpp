@@ -749,7 +749,7 @@ std::string format_report_markdown(const ReproductionReport& r, const Reproducti
     const InitialConditionDesign d = study_design(t.table.cases.front().study);
     os << "- " << table_heading(t.table) << " (`" << t.table.file << "`): design " << to_string(d.kind);
     if (d.kind == InitialConditionKind::Grid) os << " " << d.grid_points_per_axis << "^" << d.balls;
-    os << ", " << t.table.cases.front().study.runs << " runs per case, " << t.table.cases.size() << " cases\n";
+    os << ", " << t.table.cases.front().study.runs << " runs per case, " << t.table.cases.size() << (t.table.cases.size() == 1 ? " case\n" : " cases\n");
   }
   os << "\nPer-run data: `runs/<table>/<case>.csv` (one line per run); all rows: `tables.csv`.\n";
   return os.str();
