@@ -23,4 +23,9 @@ AdapterOutcome run_nlopt(EvaluationDriver& driver, const AlgorithmInfo& algorith
 
 AdapterOutcome run_ipopt(EvaluationDriver& driver, const OptimizerOptions& options, const std::vector<double>& x0);
 
+// SAO (sao.cpp) with options.sao; `problem` gives the variables (every evaluation goes through the
+// driver).
+AdapterOutcome run_sao(EvaluationDriver& driver, Problem& problem, const OptimizerOptions& options,
+                       const std::vector<double>& x0);
+
 }  // namespace abuopt::opt::detail

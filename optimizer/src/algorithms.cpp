@@ -44,6 +44,9 @@ const std::vector<AlgorithmInfo>& algorithms() {
       {"IPOPT", F::local_gradient, true, true, false,
        "interior-point method (Ipopt) with limited-memory Hessian; constraints of both kinds; "
        "finite-difference gradients and Jacobian"},
+      {"SAO", F::local_derivative_free, true, true, false,
+       "sequential approximate optimisation: least-squares response surfaces in a trust region; constraints "
+       "of both kinds; for expensive, noisy problems (options in the sao: section)"},
   };
   return list;
 }

@@ -57,7 +57,7 @@ std::string file_safe(const std::string& s) {
 SolverSpec solver_spec(const std::string& label, const std::string& algorithm) {
   SolverSpec s;
   s.label = label;
-  if (!is_sao_algorithm(algorithm)) find_algorithm(algorithm, "solver " + label + ": algorithm");
+  find_algorithm(algorithm, "solver " + label + ": algorithm");
   s.options.algorithm = algorithm;
   return s;
 }
@@ -65,7 +65,7 @@ SolverSpec solver_spec(const std::string& label, const std::string& algorithm) {
 SolverSpec read_solver_spec(YamlReader& r) {
   SolverSpec s;
   const std::string algorithm = r.get_string("algorithm");
-  if (!is_sao_algorithm(algorithm)) find_algorithm(algorithm, r.key_path("algorithm"));
+  find_algorithm(algorithm, r.key_path("algorithm"));
   s.label = r.get_string_or("label", algorithm);
   if (s.label.empty()) throw ConfigError(r.key_path("label"), "\"\"", "must not be empty");
   YamlReader options = r.child("options");
@@ -73,6 +73,8 @@ SolverSpec read_solver_spec(YamlReader& r) {
     if (options.has("algorithm"))
       throw ConfigError(options.key_path("algorithm"), yaml_value_text(options.node()["algorithm"]),
                         "give the algorithm once, as " + r.key_path("algorithm"));
+    if (options.has("sao"))
+      throw ConfigError(options.key_path("sao"), "<section>", "give the SAO settings as " + r.key_path("sao"));
     s.options = read_optimizer_options(options);
   }
   s.options.algorithm = algorithm;
@@ -80,7 +82,7 @@ SolverSpec read_solver_spec(YamlReader& r) {
   if (sao.present()) {
     if (!is_sao_algorithm(algorithm))
       throw ConfigError(r.key_path("sao"), "<section>", "only for algorithm sao (this solver is " + algorithm + ")");
-    s.sao = read_sao_options(sao);
+    s.options.sao = read_sao_options(sao);
   }
   r.finish();
   return s;
@@ -180,12 +182,8 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
   labels.clear();
   for (const SolverSpec& s : setup.solvers) {
     if (!labels.insert(s.label).second) throw ConfigError("compare.solvers", s.label, "duplicate solver label");
-    OptimizerOptions check = s.options;
-    if (is_sao_algorithm(check.algorithm)) {
-      check.algorithm = "COBYLA";
-      s.sao.validate("compare.solvers[" + s.label + "].sao");
-    }
-    check.validate();
+    if (is_sao_algorithm(s.options.algorithm)) s.options.sao.validate("compare.solvers[" + s.label + "].sao");
+    s.options.validate();
   }
 
   ComparisonResult out;
@@ -211,7 +209,7 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
         rec.dimension = problem->dimension();
         rec.x0 = starts[k];
         try {
-          rec.result = minimize_any(*problem, o, solver.sao, starts[k]);
+          rec.result = minimize(*problem, o, starts[k]);
         } catch (const ConfigError& e) {
           // e.g. a bound-only global algorithm on a constrained problem: recorded as a failed run
           rec.result.problem_name = problem->name();

@@ -1,9 +1,11 @@
 #include "evaluation_driver.hpp"
 
 #include <algorithm>
+#include <csignal>
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <mutex>
 
 namespace abuopt::opt::detail {
 
@@ -14,6 +16,35 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 std::atomic<bool>& interrupt_flag() noexcept {
   static std::atomic<bool> flag{false};
   return flag;
+}
+
+namespace {
+extern "C" void abuopt_sigint_handler(int) { abuopt::opt::detail::interrupt_flag().store(true); }
+
+std::mutex& sigint_mutex() {
+  static std::mutex m;
+  return m;
+}
+int sigint_users = 0;                 // guarded by sigint_mutex()
+struct sigaction sigint_previous {};  // the handler before the first guard
+}  // namespace
+
+SigintGuard::SigintGuard(bool enable) : enabled_(enable) {
+  if (!enabled_) return;
+  std::lock_guard<std::mutex> lock(sigint_mutex());
+  if (sigint_users++ == 0) {
+    struct sigaction sa {};
+    sa.sa_handler = abuopt_sigint_handler;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = 0;
+    sigaction(SIGINT, &sa, &sigint_previous);
+  }
+}
+
+SigintGuard::~SigintGuard() {
+  if (!enabled_) return;
+  std::lock_guard<std::mutex> lock(sigint_mutex());
+  if (--sigint_users == 0) sigaction(SIGINT, &sigint_previous, nullptr);
 }
 
 EvaluationDriver::EvaluationDriver(Problem& problem, const OptimizerOptions& options,

@@ -18,6 +18,20 @@ namespace abuopt::opt::detail {
 // Set by the SIGINT handler and request_stop().
 std::atomic<bool>& interrupt_flag() noexcept;
 
+// Installs the SIGINT handler (it only sets interrupt_flag()) while at least one run that wants
+// it is alive, and restores the previous handler when the last one ends. The one Ctrl-C mechanism
+// of every algorithm minimize() runs (NLopt, Ipopt, SAO).
+class SigintGuard {
+ public:
+  explicit SigintGuard(bool enable);
+  ~SigintGuard();
+  SigintGuard(const SigintGuard&) = delete;
+  SigintGuard& operator=(const SigintGuard&) = delete;
+
+ private:
+  bool enabled_;
+};
+
 struct EvaluatedPoint {
   std::vector<double> x;  // real units, inside the bounds
   Evaluation e;

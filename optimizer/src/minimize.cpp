@@ -1,8 +1,6 @@
 #include "abuopt/optimizer/minimize.hpp"
 
-#include <csignal>
 #include <exception>
-#include <mutex>
 
 #include "abuopt/common/config_error.hpp"
 #include "adapters.hpp"
@@ -13,46 +11,6 @@ namespace abuopt::opt {
 void request_stop() noexcept { detail::interrupt_flag().store(true); }
 
 namespace {
-
-extern "C" void abuopt_sigint_handler(int) { abuopt::opt::detail::interrupt_flag().store(true); }
-
-// Installs the SIGINT handler while at least one run wants it; restores the previous handler.
-class SigintGuard {
- public:
-  explicit SigintGuard(bool enable) : enabled_(enable) {
-    if (!enabled_) return;
-    std::lock_guard<std::mutex> lock(mutex());
-    if (users()++ == 0) {
-      struct sigaction sa {};
-      sa.sa_handler = abuopt_sigint_handler;
-      sigemptyset(&sa.sa_mask);
-      sa.sa_flags = 0;
-      sigaction(SIGINT, &sa, &previous());
-    }
-  }
-  ~SigintGuard() {
-    if (!enabled_) return;
-    std::lock_guard<std::mutex> lock(mutex());
-    if (--users() == 0) sigaction(SIGINT, &previous(), nullptr);
-  }
-  SigintGuard(const SigintGuard&) = delete;
-  SigintGuard& operator=(const SigintGuard&) = delete;
-
- private:
-  static std::mutex& mutex() {
-    static std::mutex m;
-    return m;
-  }
-  static int& users() {
-    static int u = 0;
-    return u;
-  }
-  static struct sigaction& previous() {
-    static struct sigaction p {};
-    return p;
-  }
-  bool enabled_;
-};
 
 std::string count_text(std::size_t k, const char* what) {
   return std::to_string(k) + " " + what + (k == 1 ? "" : "s");
@@ -102,7 +60,7 @@ OptimizationResult minimize(Problem& problem, const OptimizerOptions& options, s
                           " needs at least 2 variables; problem '" + problem.name() + "' has 1 (use COBYLA or SBPLX)");
 
   // ---- the run: from here on nothing throws; the best point so far is always returned ----
-  SigintGuard sigint(options.handle_sigint);
+  detail::SigintGuard sigint(options.handle_sigint);
   detail::interrupt_flag().store(false);
   detail::EvaluationDriver driver(problem, options, callback);
   detail::AdapterOutcome outcome;
@@ -110,6 +68,8 @@ OptimizationResult minimize(Problem& problem, const OptimizerOptions& options, s
   try {
     if (algorithm.name == "IPOPT")
       outcome = detail::run_ipopt(driver, options, x0);
+    else if (algorithm.name == "SAO")
+      outcome = detail::run_sao(driver, problem, options, x0);
     else
       outcome = detail::run_nlopt(driver, algorithm, local, wrap, options, x0);
   } catch (const std::exception& ex) {

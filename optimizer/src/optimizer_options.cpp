@@ -24,10 +24,11 @@ void OptimizerOptions::validate() const {
     const AlgorithmInfo& local = find_algorithm(local_algorithm, "optimizer.local_algorithm");
     if (local.family != AlgorithmFamily::local_derivative_free && local.family != AlgorithmFamily::local_gradient)
       throw ConfigError("optimizer.local_algorithm", local_algorithm, "must be a local algorithm (not global or AUGLAG)");
-    if (local.name == "IPOPT")
-      throw ConfigError("optimizer.local_algorithm", local_algorithm, "IPOPT cannot be a local algorithm of NLopt");
+    if (local.name == "IPOPT" || local.name == "SAO")
+      throw ConfigError("optimizer.local_algorithm", local_algorithm,
+                        local.name + " cannot be a local algorithm of NLopt");
   }
-  (void)info;
+  if (info.name == "SAO") sao.validate("sao");
   require(max_evaluations > 0, "max_evaluations", static_cast<double>(max_evaluations), "must be > 0");
   require(std::isfinite(max_time_s) && max_time_s >= 0, "max_time_s", max_time_s, "must be >= 0 (0: no limit)");
   require(max_iterations >= 0, "max_iterations", static_cast<double>(max_iterations), "must be >= 0 (0: default)");
@@ -45,7 +46,7 @@ void OptimizerOptions::validate() const {
   require(print_level >= 0 && print_level <= 12, "print_level", print_level, "must be in [0, 12]");
 }
 
-OptimizerOptions read_optimizer_options(YamlReader& r) {
+OptimizerOptions read_optimizer_options(YamlReader& r, YamlReader* sao_section) {
   OptimizerOptions o;
   o.algorithm = r.get_string_or("algorithm", o.algorithm);
   find_algorithm(o.algorithm, r.key_path("algorithm"));
@@ -70,6 +71,19 @@ OptimizerOptions read_optimizer_options(YamlReader& r) {
   o.print_level = static_cast<int>(r.get_int_or("print_level", o.print_level, Rule::in_range(0, 12)));
   o.handle_sigint = r.get_bool_or("handle_sigint", o.handle_sigint);
   o.keep_history = r.get_bool_or("keep_history", o.keep_history);
+  const bool is_sao = find_algorithm(o.algorithm).name == "SAO";
+  YamlReader nested = r.child("sao");
+  const bool outer = sao_section && sao_section->present();
+  if (nested.present() && outer)
+    throw ConfigError(nested.path(), "<section>", "SAO settings are given twice (also as " + sao_section->path() +
+                                                      "); keep one");
+  YamlReader* sao = nested.present() ? &nested : outer ? sao_section : nullptr;
+  if (sao) {
+    if (!is_sao)
+      throw ConfigError(sao->path(), "<section>",
+                        "only used with " + r.key_path("algorithm") + ": SAO (algorithm is " + o.algorithm + ")");
+    o.sao = read_sao_options(*sao);
+  }
   r.finish();
   o.validate();
   return o;

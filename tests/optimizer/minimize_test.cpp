@@ -129,6 +129,23 @@ TEST(Minimize, SigintInterruptsAndRestoresThePreviousHandler) {
   EXPECT_TRUE(minimize(q, with("SBPLX")).success());
 }
 
+// SAO runs behind the same SIGINT guard (one mechanism for every algorithm).
+TEST(Minimize, SigintInterruptsSaoAndRestoresThePreviousHandler) {
+  struct sigaction before {};
+  sigaction(SIGINT, nullptr, &before);
+  auto p = quadratic();
+  const auto r = minimize(p, with("SAO"), {}, [](const Progress& pr) {
+    if (pr.evaluations == 5) std::raise(SIGINT);
+    return true;
+  });
+  EXPECT_EQ(r.reason, TerminationReason::interrupted);
+  EXPECT_EQ(r.evaluations, 5);
+  EXPECT_EQ(r.algorithm, "SAO(auto)");
+  struct sigaction after {};
+  sigaction(SIGINT, nullptr, &after);
+  EXPECT_EQ(after.sa_handler, before.sa_handler);
+}
+
 TEST(Minimize, RequestStopInterruptsIpopt) {
   auto p = quadratic();
   const auto r = minimize(p, with("IPOPT"), {0.9, 0.9}, [](const Progress& pr) {

@@ -107,6 +107,50 @@ TEST(Algorithms, NamesAreCaseInsensitive) {
   EXPECT_FALSE(find_algorithm("mma").equality_constraints);
   EXPECT_TRUE(find_algorithm("auglag").needs_local);
   EXPECT_EQ(algorithm_names().size(), algorithms().size());
+  EXPECT_EQ(find_algorithm("sao").name, "SAO");
+  EXPECT_TRUE(find_algorithm("Sao").inequality_constraints);
+}
+
+// SAO is an algorithm name like the others; its settings come from optimizer.sao or from a
+// section the caller passes (e.g. a top-level sao:), never both, and only with algorithm SAO.
+TEST(OptimizerOptions, SaoSettingsFromTheNestedOrAPassedSection) {
+  OptimizerOptions o = read("optimizer:\n  algorithm: SAO\n  sao: {initial_radius: 0.2, doe_points_factor: 2}\n");
+  EXPECT_EQ(o.algorithm, "SAO");
+  EXPECT_DOUBLE_EQ(o.sao.initial_radius, 0.2);
+  EXPECT_DOUBLE_EQ(o.sao.doe_points_factor, 2.0);
+  EXPECT_DOUBLE_EQ(read("optimizer:\n  algorithm: sao\n").sao.initial_radius, SaoOptions{}.initial_radius);
+
+  YamlReader root = YamlReader::load_string("optimizer: {algorithm: sao}\nsao: {max_radius: 0.7}\n");
+  YamlReader section = root.child("optimizer");
+  YamlReader outer = root.child("sao");
+  EXPECT_DOUBLE_EQ(read_optimizer_options(section, &outer).sao.max_radius, 0.7);
+
+  EXPECT_EQ(error_of([] { read("optimizer:\n  algorithm: cobyla\n  sao: {initial_radius: 0.2}\n"); }),
+            "optimizer.sao = <section>: only used with optimizer.algorithm: SAO (algorithm is cobyla)");
+  EXPECT_EQ(error_of([] { read("optimizer:\n  algorithm: sao\n  sao: {min_radius: 0}\n"); }),
+            "optimizer.sao.min_radius = 0: must be in (0, initial_radius = 0.1]");
+  EXPECT_EQ(error_of([] { read("optimizer:\n  algorithm: sao\n  sao: {radius: 1}\n"); }).rfind("optimizer.sao.radius", 0),
+            0u);
+  EXPECT_EQ(error_of([] {
+              YamlReader r = YamlReader::load_string("optimizer: {algorithm: sao, sao: {}}\nsao: {max_radius: 0.7}\n");
+              YamlReader s = r.child("optimizer");
+              YamlReader t = r.child("sao");
+              read_optimizer_options(s, &t);
+            }).rfind("optimizer.sao = <section>: SAO settings are given twice", 0),
+            0u);
+  EXPECT_EQ(error_of([] {
+              OptimizerOptions bad;
+              bad.local_algorithm = "sao";
+              bad.validate();
+            }),
+            "optimizer.local_algorithm = sao: SAO cannot be a local algorithm of NLopt");
+  EXPECT_EQ(error_of([] {
+              OptimizerOptions bad;
+              bad.algorithm = "SAO";
+              bad.sao.shrink_factor = 2;
+              bad.validate();
+            }),
+            "sao.shrink_factor = 2: must be in (0, 1)");
 }
 
 }  // namespace

@@ -215,6 +215,16 @@ TEST(Sao, MinimizeAnyDispatchesByName) {
   EXPECT_EQ(opt::minimize_any(*problem, o).algorithm, "SAO(auto)");
   o.algorithm = "cobyla";
   EXPECT_EQ(opt::minimize_any(*problem, o).algorithm, "COBYLA");
+  // minimize() itself knows SAO, with its settings in OptimizerOptions::sao
+  o.algorithm = "sao";
+  o.sao.surrogate = "linear";
+  const opt::OptimizationResult via_minimize = opt::minimize(*problem, o);
+  EXPECT_EQ(via_minimize.algorithm, "SAO(linear)");
+  opt::SaoOptions linear;
+  linear.surrogate = "linear";
+  const opt::OptimizationResult via_sao = opt::minimize_sao(*problem, opt::OptimizerOptions{}, linear);
+  EXPECT_EQ(via_minimize.evaluations, via_sao.evaluations);
+  EXPECT_EQ(via_minimize.x, via_sao.x);
   EXPECT_TRUE(opt::is_sao_algorithm("SAO"));
   EXPECT_FALSE(opt::is_sao_algorithm("SLSQP"));
 }

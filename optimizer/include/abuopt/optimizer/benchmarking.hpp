@@ -42,12 +42,11 @@
 
 namespace abuopt::opt {
 
-// One optimiser of a comparison: any algorithm name of minimize() (NLopt names, IPOPT) or SAO.
+// One optimiser of a comparison: any algorithm name of minimize() (NLopt names, IPOPT, SAO).
 struct SolverSpec {
   std::string label;         // its name in tables and plots (unique)
-  OptimizerOptions options;  // algorithm and settings; max_evaluations, constraint_tolerance and
-                             // seed are set per run from the ProblemSpec
-  SaoOptions sao;            // used when options.algorithm is "SAO"
+  OptimizerOptions options;  // algorithm and settings (SAO's in options.sao); max_evaluations,
+                             // constraint_tolerance and seed are set per run from the ProblemSpec
 };
 // A solver with default settings; `algorithm` is checked (ConfigError listing the valid names).
 SolverSpec solver_spec(const std::string& label, const std::string& algorithm);

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "abuopt/common/yaml_reader.hpp"
+#include "abuopt/optimizer/sao_options.hpp"
 
 namespace abuopt::opt {
 
@@ -17,7 +18,7 @@ enum class FiniteDifference { forward, central };
 std::string to_string(FiniteDifference kind);
 
 struct OptimizerOptions {
-  // Algorithm name, case-insensitive (COBYLA, BOBYQA, SLSQP, IPOPT, ...; algorithm_names()).
+  // Algorithm name, case-insensitive (COBYLA, BOBYQA, SLSQP, IPOPT, SAO, ...; algorithm_names()).
   std::string algorithm = "cobyla";
   // Local optimiser for AUGLAG and MLSL_LDS, and the one a bound-only local algorithm is wrapped
   // around when the problem has constraints. Empty: BOBYQA (SBPLX for one variable).
@@ -71,6 +72,9 @@ struct OptimizerOptions {
   // Keep every evaluation in OptimizationResult::history.
   bool keep_history = true;
 
+  // Settings of SAO, used when algorithm is SAO (docs/sao.md); ignored otherwise.
+  SaoOptions sao;
+
   // Throws abuopt::ConfigError naming the key, the value and the rule
   // ("optimizer.max_evaluations = 0: must be > 0"); unknown algorithm names list the valid ones.
   void validate() const;
@@ -78,6 +82,9 @@ struct OptimizerOptions {
 
 // Reads the keys of an `optimizer:` section (pass root.child("optimizer")); absent keys keep their
 // defaults, unknown keys are errors (the section's finish() is called), then validate().
-OptimizerOptions read_optimizer_options(YamlReader& section);
+// SAO's settings come from the section's own `sao:` key (optimizer: {algorithm: SAO, sao: {...}})
+// or, for a config that keeps them elsewhere (e.g. a top-level `sao:`), from `sao_section`
+// (finish() is called on it too); giving both, or either with another algorithm, is an error.
+OptimizerOptions read_optimizer_options(YamlReader& section, YamlReader* sao_section = nullptr);
 
 }  // namespace abuopt::opt

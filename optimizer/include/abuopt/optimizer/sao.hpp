@@ -38,94 +38,22 @@
 //   OptimizerOptions::max_evaluations / max_time_s / target / SIGINT / callback as in minimize().
 // Like every optimiser, success() only if converged AND the best point is feasible.
 //
-// Options read from OptimizerOptions: max_evaluations, max_time_s, max_iterations, target,
-// constraint_tolerance, seed (LHS), handle_sigint, keep_history. The algorithm name is ignored
-// (minimize() knows "SAO" only once the dispatcher hooks minimize_sao in).
+// SAO is an algorithm of minimize() like any other: `algorithm: SAO` (any case) runs it with
+// OptimizerOptions::sao, through the same evaluation wrapper, SIGINT handling and result
+// building. Options used besides `sao`: max_evaluations, max_time_s, max_iterations, target,
+// constraint_tolerance, seed (LHS), handle_sigint, keep_history.
 #include <string>
 #include <vector>
 
-#include "abuopt/common/yaml_reader.hpp"
 #include "abuopt/optimizer/minimize.hpp"
+#include "abuopt/optimizer/sao_options.hpp"
 
 namespace abuopt::opt {
 
-class EvaluationArchive;  // evaluation_archive.hpp
-
-struct SaoOptions {
-  // Surrogate of the objective and of every constraint: auto, linear, interactions,
-  // pure_quadratic, quadratic, kriging. auto: the richest of quadratic > pure_quadratic > linear
-  // that the points of the region support.
-  std::string surrogate = "auto";
-  // Candidate DOE in the region: auto, koshal, axial, central_composite, lhs.
-  // auto: koshal for a linear surrogate, axial (centre and +-r on each axis) then the corners of
-  // a central composite design for the quadratic ones, lhs for kriging.
-  std::string doe = "auto";
-  // Points wanted in the region before fitting; 0: automatic (linear: n+1, interactions: its
-  // term count, pure_quadratic / auto / kriging: 2n+1, quadratic: (n+1)(n+2)/2).
-  int doe_points = 0;
-  // Multiplies the automatic count (doe_points == 0). Noisy problems: 2 (least squares over about
-  // twice as many points as terms smooths the noise instead of interpolating it). In [1, 10].
-  double doe_points_factor = 1.0;
-  // A DOE candidate within this distance (infinity norm, local coordinates where the region is
-  // [-1,1]^n) of a known point is covered by it and not evaluated. In (0, 1].
-  double reuse_distance = 0.3;
-  // Fit also on the points of the neighbourhood |s|_inf <= neighbourhood (>= 1; 1: region only),
-  // weighted 1/|s|_inf^4.
-  double neighbourhood = 2.0;
-
-  // Trust region half-width as a fraction of each variable's range.
-  double initial_radius = 0.1;   // in (0, 1]
-  double min_radius = 1e-5;      // stop below it; in (0, initial_radius]
-  double max_radius = 0.5;       // in [initial_radius, 1]
-  double shrink_factor = 0.25;   // in (0, 1)
-  double expand_factor = 2.0;    // >= 1
-  // Ratio-test thresholds (Dakota's defaults).
-  double rho_shrink = 0.25;      // rho <= rho_shrink: shrink (rho <= 0: also reject)
-  double rho_expand_low = 0.75;  // rho in [rho_expand_low, rho_expand_high] and the step on
-  double rho_expand_high = 1.25; // the boundary: expand
-
-  // Zeroth-order additive correction (Dakota's `correction additive zeroth_order`): every
-  // surrogate is shifted to match the true value at the centre.
-  bool correction = true;
-  // An accepted step shorter than short_step * r (infinity norm) also shrinks the region by
-  // shrink_factor: the surrogates say the optimum is near, and a smaller region refines them
-  // (without it a biased model creeps in ever smaller steps with rho ~ 1). 0: off. In [0, 1).
-  double short_step = 0.1;
-
-  // Initial exact-penalty weight mu; 0: automatic, 10 max(1, |f(x0)|).
-  double penalty_initial = 0.0;
-  // mu >= penalty_multiplier_factor * max |lambda| (estimated multipliers); >= 1.
-  double penalty_multiplier_factor = 2.0;
-
-  // Stall test: no improvement of the centre's merit by more than
-  // stall_tolerance * max(1, |phi|) for stall_iterations iterations.
-  int stall_iterations = 8;       // >= 1
-  double stall_tolerance = 1e-8;  // >= 0
-
-  // Sub-problem solver: slsqp (NLopt SLSQP, surrogate gradients) or cobyla (NLopt COBYLA).
-  std::string subproblem_solver = "slsqp";
-  int subproblem_max_evaluations = 500;  // per start; >= 10
-  // Kriging nugget (relative to the process variance); raise it (e.g. 1e-2) for noisy problems.
-  double kriging_nugget = 1e-8;
-
-  // Points of this archive (same problem id) inform the surrogates without being evaluated
-  // again. Not read from YAML; not owned; may be null.
-  const EvaluationArchive* archive = nullptr;
-
-  // Throws abuopt::ConfigError naming the key, the value and the rule
-  // ("sao.min_radius = 0: must be in (0, initial_radius = 0.1]"); `prefix` is the section's path.
-  void validate(const std::string& prefix = "sao") const;
-};
-
-// Reads the keys of a `sao:` section (pass root.child("sao")); absent keys keep their defaults,
-// unknown keys are errors (finish() is called), then validate().
-SaoOptions read_sao_options(YamlReader& section);
-
-// Minimises `problem` from x0 (empty: problem.initial_point()) by SAO.
-// Throws abuopt::ConfigError before any evaluation for invalid options (the algorithm name in
-// `options` is not checked), an invalid problem or starting point. Once evaluations start it
-// never throws: everything else is a TerminationReason. The result's algorithm is
-// "SAO(<surrogate>)".
+// minimize() with algorithm SAO and OptimizerOptions::sao = `sao` (the algorithm name and
+// local_algorithm in `options` are ignored). Throws abuopt::ConfigError before any evaluation for
+// invalid options, an invalid problem or starting point. Once evaluations start it never throws:
+// everything else is a TerminationReason. The result's algorithm is "SAO(<surrogate>)".
 OptimizationResult minimize_sao(Problem& problem, const OptimizerOptions& options, const SaoOptions& sao,
                                 std::vector<double> x0 = {}, const EvaluationCallback& callback = {});
 
@@ -133,7 +61,8 @@ OptimizationResult minimize_sao(Problem& problem, const OptimizerOptions& option
 // minimize_sao() by algorithm name.
 bool is_sao_algorithm(const std::string& name);
 
-// minimize() for every algorithm name, plus "SAO" (with `sao` options).
+// For callers that hold the SAO options apart from the OptimizerOptions: minimize_sao() with `sao`
+// when options.algorithm is SAO, else minimize(problem, options) (`sao` unused).
 OptimizationResult minimize_any(Problem& problem, const OptimizerOptions& options, const SaoOptions& sao = {},
                                 std::vector<double> x0 = {}, const EvaluationCallback& callback = {});
 
