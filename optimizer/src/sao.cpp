@@ -196,8 +196,11 @@ class SaoRun {
 
   // ---- one iteration ----
   std::string planned_basis() const;
+  double geometry_spread() const { return sao_.geometry_spread; }
   int wanted_points(const std::string& basis) const;
   bool fill_region(const std::string& basis);  // false: stopped
+  bool minimal_design() const;
+  bool repair_geometry();  // false: stopped
   std::optional<Models> fit(const std::string& basis) const;
   Eigen::VectorXd solve_subproblem(const Models& models, bool& feasibility_phase);
   Eigen::VectorXd run_nlopt(const Models& models, bool feasibility_phase, const Eigen::VectorXd& start,
@@ -272,6 +275,68 @@ int SaoRun::wanted_points(const std::string& basis) const {
   if (basis == "interactions") count = surrogate::terms_count(Basis::kInteractions, n_);
   if (basis == "quadratic") count = surrogate::terms_count(Basis::kQuadratic, n_);
   return static_cast<int>(std::ceil(sao_.doe_points_factor * count));
+}
+
+// The default (doe auto, no explicit point count, no factor, response surfaces): no fresh design
+// per region; every evaluated point joins the fit and a point is added only where the geometry of
+// the fit zone is poor (repair_geometry).
+bool SaoRun::minimal_design() const {
+  return sao_.doe == "auto" && sao_.doe_points == 0 && sao_.doe_points_factor == 1.0 && sao_.surrogate != "kriging";
+}
+
+// Adds points until the ok points of the fit zone (|s|_inf <= neighbourhood, weights as in fit())
+// determine a linear model with spread: the weighted covariance of their local coordinates has
+// smallest eigenvalue >= geometry^2 (in region units). Each added point lies on the region's
+// boundary along the weakest direction (the eigenvector), on the side farther from known points.
+bool SaoRun::repair_geometry() {
+  Eigen::VectorXd lo(n_), hi(n_);
+  for (int i = 0; i < n_; ++i) {
+    lo[i] = (std::max(0.0, centre_z_[i] - radius_) - centre_z_[i]) / radius_;
+    hi[i] = (std::min(1.0, centre_z_[i] + radius_) - centre_z_[i]) / radius_;
+  }
+  const double spread = geometry_spread();
+  for (int added = 0; added <= 2 * n_ + 1; ++added) {
+    std::vector<Eigen::VectorXd> occupied;
+    Eigen::VectorXd mean = Eigen::VectorXd::Zero(n_);
+    Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(n_, n_);
+    double wsum = 0;
+    int m = 0;
+    std::vector<std::pair<Eigen::VectorXd, double>> zone;
+    for (const KnownPoint& p : known_) {
+      const Eigen::VectorXd sp = to_s(p.z);
+      const double d = sp.cwiseAbs().maxCoeff();
+      if (d <= sao_.neighbourhood * (1 + 1e-9)) occupied.push_back(sp);
+      if (!p.ok || d > sao_.neighbourhood * (1 + 1e-9)) continue;
+      const double w = d <= 1 + 1e-9 ? 1.0 : 1.0 / std::pow(d, 4);
+      zone.emplace_back(sp, w);
+      mean += w * sp;
+      wsum += w;
+      ++m;
+    }
+    Eigen::VectorXd weakest = Eigen::VectorXd::Unit(n_, 0);
+    if (wsum > 0) {
+      mean /= wsum;
+      for (const auto& [sp, w] : zone) cov += w * (sp - mean) * (sp - mean).transpose();
+      cov /= wsum;
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(cov);
+      const double lambda = eig.eigenvalues()[0];
+      if (m >= n_ + 1 && lambda >= spread * spread) return true;
+      weakest = eig.eigenvectors().col(0);
+    }
+    weakest /= weakest.cwiseAbs().maxCoeff();
+    auto distance_to_occupied = [&](const Eigen::VectorXd& s) {
+      double d = kInf;
+      for (const auto& o : occupied) d = std::min(d, (s - o).cwiseAbs().maxCoeff());
+      return d;
+    };
+    const Eigen::VectorXd plus = weakest.cwiseMax(lo).cwiseMin(hi);
+    const Eigen::VectorXd minus = (-weakest).cwiseMax(lo).cwiseMin(hi);
+    const double dp = distance_to_occupied(plus), dm = distance_to_occupied(minus);
+    const Eigen::VectorXd& s = dp >= dm ? plus : minus;
+    if (std::max(dp, dm) < 1e-3) return true;  // nothing new to add inside the box
+    if (!evaluate(from_s(s))) return false;
+  }
+  return true;
 }
 
 // Candidate DOE designs in [-1,1]^n for the region, in order of preference.
@@ -617,7 +682,7 @@ void SaoRun::run(const std::vector<double>& x0) {
     ++iterations;
 
     const std::string basis = planned_basis();
-    if (!fill_region(basis)) return;
+    if (!(minimal_design() ? repair_geometry() : fill_region(basis))) return;
     std::optional<Models> models = fit(basis);
     if (!models) {  // nothing to fit (e.g. every point failed): try a smaller region
       radius_ *= sao_.shrink_factor;

@@ -57,6 +57,8 @@ void SaoOptions::validate(const std::string& p) const {
           reuse_distance, "must be in (0, 1]");
   require(std::isfinite(neighbourhood) && neighbourhood >= 1 && neighbourhood <= 10, p, "neighbourhood",
           neighbourhood, "must be in [1, 10]");
+  require(std::isfinite(geometry_spread) && geometry_spread > 0 && geometry_spread < 1, p, "geometry_spread",
+          geometry_spread, "must be in (0, 1)");
   require(std::isfinite(initial_radius) && initial_radius > 0 && initial_radius <= 1, p, "initial_radius",
           initial_radius, "must be in (0, 1]");
   require(std::isfinite(min_radius) && min_radius > 0 && min_radius <= initial_radius, p, "min_radius", min_radius,
@@ -99,6 +101,7 @@ SaoOptions read_sao_options(YamlReader& r) {
   o.doe_points_factor = r.get_double_or("doe_points_factor", o.doe_points_factor);
   o.reuse_distance = r.get_double_or("reuse_distance", o.reuse_distance);
   o.neighbourhood = r.get_double_or("neighbourhood", o.neighbourhood);
+  o.geometry_spread = r.get_double_or("geometry_spread", o.geometry_spread);
   o.initial_radius = r.get_double_or("initial_radius", o.initial_radius);
   o.min_radius = r.get_double_or("min_radius", o.min_radius);
   o.max_radius = r.get_double_or("max_radius", o.max_radius);

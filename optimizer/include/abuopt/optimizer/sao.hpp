@@ -10,13 +10,16 @@
 // One iteration, in the unit box z = (x - lower) / (upper - lower) (every variable scaled to its
 // bounds) around the centre z_c with radius r (half-width, a fraction of each variable's range):
 //   1. Region R = [z_c - r, z_c + r] clipped to [0, 1]^n. Local coordinates s = (z - z_c) / r.
-//   2. DOE with reuse: every evaluated point (this run, and the entries of an attached
-//      EvaluationArchive) lying in R counts. Candidate DOE points (Koshal, axial, central
-//      composite or Latin hypercube in R) that are within `reuse_distance` (in s) of a point
-//      already known are covered by it; the others are evaluated, farthest-from-known first,
-//      until R holds `doe_points` points spanning a linear model.
+//   2. Points: every evaluated point (this run, and the entries of an attached
+//      EvaluationArchive) is kept; those in the fit zone |s|_inf <= neighbourhood (4) are fitted.
+//      Default (doe auto): no design per region; a point is added on the boundary of R along the
+//      weakest direction only while the zone's weighted spread is below geometry_spread (or it
+//      holds fewer than n+1 points): about n+1 points at the start, few afterwards. With an
+//      explicit design, doe_points, doe_points_factor > 1 or kriging, each region is filled with
+//      a Koshal / axial / central composite / Latin hypercube design, reusing known points within
+//      `reuse_distance` (in s), farthest-from-known first.
 //   3. Surrogates of f, every g_i and every h_j, fitted by weighted least squares in s on the
-//      points of R (weight 1) and of the neighbourhood 2R (weight 1/|s|_inf^4). Basis "auto":
+//      points of R (weight 1) and of the rest of the fit zone (weight 1/|s|_inf^4). Basis "auto":
 //      quadratic if there are enough points, else pure quadratic, else linear.
 //   4. Sub-problem: minimise f^(s) s.t. g^(s) <= 0, h^(s) = 0, s in R, with NLopt SLSQP and
 //      analytic surrogate gradients, from the centre and from the best known point in R. If the

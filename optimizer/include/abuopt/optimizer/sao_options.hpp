@@ -20,21 +20,32 @@ struct SaoOptions {
   // that the points of the region support.
   std::string surrogate = "auto";
   // Candidate DOE in the region: auto, koshal, axial, central_composite, lhs.
-  // auto: koshal for a linear surrogate, axial (centre and +-r on each axis) then the corners of
-  // a central composite design for the quadratic ones, lhs for kriging.
+  // auto (with doe_points 0, doe_points_factor 1 and a response surface): no design per region;
+  // every evaluated point joins the fit and points are added only where the fit zone lacks spread
+  // (see geometry_spread): about n+1 points at the start, few afterwards. Otherwise (an explicit
+  // design, a point count, a factor > 1 or kriging) each region is filled with the design:
+  // koshal for a linear surrogate, axial (centre and +-r on each axis) then the corners of a
+  // central composite design for the quadratic ones, lhs for kriging.
   std::string doe = "auto";
-  // Points wanted in the region before fitting; 0: automatic (linear: n+1, interactions: its
-  // term count, pure_quadratic / auto / kriging: 2n+1, quadratic: (n+1)(n+2)/2).
+  // Points wanted in the region before fitting (designs per region only); 0: automatic (linear:
+  // n+1, interactions: its term count, pure_quadratic / auto / kriging: 2n+1, quadratic:
+  // (n+1)(n+2)/2).
   int doe_points = 0;
-  // Multiplies the automatic count (doe_points == 0). Noisy problems: 2 (least squares over about
-  // twice as many points as terms smooths the noise instead of interpolating it). In [1, 10].
+  // Multiplies the automatic count (doe_points == 0) and, above 1, selects designs per region.
+  // Noisy problems: 2 (least squares over about twice as many points as terms smooths the noise
+  // instead of interpolating it). In [1, 10].
   double doe_points_factor = 1.0;
   // A DOE candidate within this distance (infinity norm, local coordinates where the region is
   // [-1,1]^n) of a known point is covered by it and not evaluated. In (0, 1].
   double reuse_distance = 0.3;
   // Fit also on the points of the neighbourhood |s|_inf <= neighbourhood (>= 1; 1: region only),
-  // weighted 1/|s|_inf^4.
-  double neighbourhood = 2.0;
+  // weighted 1/|s|_inf^4 (the fit zone). In [1, 10].
+  double neighbourhood = 4.0;
+  // Geometry of the fit zone without a design per region (doe auto): a point is added on the
+  // region's boundary along the weakest direction while the weighted covariance of the zone's
+  // local coordinates has its smallest eigenvalue below geometry_spread^2 (or the zone has fewer
+  // than n+1 points). In (0, 1).
+  double geometry_spread = 0.2;
 
   // Trust region half-width as a fraction of each variable's range.
   double initial_radius = 0.1;   // in (0, 1]
