@@ -14,6 +14,10 @@
 //       seed: 1
 //       constraint_tolerance: 1e-6
 //       f_star: 0                    # optional reference (default: best_known)
+//     - startup_profile: {abu: ..., profile: ..., montecarlo: ..., design: ..., objective: ...,
+//                         constraints: ...}   # the sections of an `abuopt optimize` config
+//       label: startup_profile       # optional; max_evaluations, starts, seed, ... as above
+//                                    # (see configs/compare/startup_profile.yaml)
 //   solvers:
 //     - {label: SAO, algorithm: sao, sao: {...}}
 //     - {label: COBYLA, algorithm: cobyla, options: {...}}   # options: the optimizer: keys
@@ -29,6 +33,7 @@
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/optimizer/benchmarking.hpp"
 #include "abuopt/problems/benchmarks/benchmark_factory.hpp"
+#include "abuopt/problems/startup_profile_problem.hpp"
 #include "commands/commands.hpp"
 
 namespace abuopt::app {
@@ -41,7 +46,37 @@ struct CompareArgs {
   bool json = false;
 };
 
+// The budget, starts, seed, tolerance and reference value of any problem entry.
+void read_run_settings(YamlReader& r, opt::ProblemSpec& spec) {
+  spec.max_evaluations = r.get_int_or("max_evaluations", 200, Rule::positive());
+  spec.starts = static_cast<int>(r.get_int_or("starts", 1, Rule::in_range(1, 1000)));
+  spec.seed = static_cast<std::uint64_t>(r.get_int_or("seed", 1, Rule::non_negative()));
+  spec.constraint_tolerance = r.get_double_or("constraint_tolerance", 1e-6, Rule::non_negative());
+  if (r.has("f_star")) spec.f_star = r.get_double("f_star");
+}
+
+// A `startup_profile:` entry: the sections of an `abuopt optimize` config (abu, profile, motor,
+// simulation, montecarlo, design, objective, constraints, validation) read by the problem's own
+// reader, so a comparison and an optimisation of the same design problem mean the same thing.
+opt::ProblemSpec read_startup_profile_problem(YamlReader& r) {
+  opt::ProblemSpec spec;
+  YamlReader section = r.child("startup_profile");
+  const problems::StartupProfileSettings settings = problems::read_startup_profile_settings(section);
+  section.finish();
+  problems::StartupProfileProblem check(settings);  // a bad design is a ConfigError now, before any run
+  spec.label = r.get_string_or("label", "startup_profile");
+  spec.make = [settings] { return std::make_unique<problems::StartupProfileProblem>(settings); };
+  read_run_settings(r, spec);
+  r.finish();
+  return spec;
+}
+
 opt::ProblemSpec read_problem(YamlReader& r) {
+  if (r.has("startup_profile")) {
+    if (r.has("benchmark"))
+      throw ConfigError(r.key_path("startup_profile"), "<section>", "give either benchmark or startup_profile, not both");
+    return read_startup_profile_problem(r);
+  }
   opt::ProblemSpec spec;
   const std::string name = r.get_string("benchmark");
   problems::BenchmarkSettings settings;
@@ -54,11 +89,7 @@ opt::ProblemSpec read_problem(YamlReader& r) {
                                             ? name + std::to_string(settings.dimension)
                                             : name);
   spec.make = [name, settings] { return problems::make_benchmark(name, settings); };
-  spec.max_evaluations = r.get_int_or("max_evaluations", 200, Rule::positive());
-  spec.starts = static_cast<int>(r.get_int_or("starts", 1, Rule::in_range(1, 1000)));
-  spec.seed = static_cast<std::uint64_t>(r.get_int_or("seed", 1, Rule::non_negative()));
-  spec.constraint_tolerance = r.get_double_or("constraint_tolerance", 1e-6, Rule::non_negative());
-  if (r.has("f_star")) spec.f_star = r.get_double("f_star");
+  read_run_settings(r, spec);
   r.finish();
   return spec;
 }

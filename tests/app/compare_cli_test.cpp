@@ -105,6 +105,8 @@ TEST(CompareCli, BadConfigIsOneMessageWithExitStatus2) {
                 "only for algorithm sao"},
            Case{"problems:\n  - {benchmark: hs071}\nsolvers:\n  - {algorithm: cobyla}\nsolverz: []\n", "solverz"},
            Case{"problems: []\nsolvers:\n  - {algorithm: cobyla}\n", "problems"},
+           Case{"problems:\n  - {benchmark: hs071, startup_profile: {}}\nsolvers:\n  - {algorithm: cobyla}\n",
+                "give either benchmark or startup_profile"},
        }) {
     const std::string cfg = write_config("compare_bad.yaml", c.yaml);
     const Result r = run("compare " + cfg + " --out " + fresh_dir("compare_cli_bad"));
