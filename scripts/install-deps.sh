@@ -8,7 +8,7 @@ packages=(
   libeigen3-dev          # linear algebra (model solves, response surfaces)
   libsundials-dev        # ARKODE/CVODE with root finding: the event-driven simulator
   libyaml-cpp-dev        # study configs
-  libnlopt-cxx-dev       # NLopt optimisers
+  libnlopt-dev libnlopt-cxx-dev  # NLopt optimisers (C API + C++ wrapper; the CMake config is in libnlopt-dev)
   coinor-libipopt-dev    # Ipopt
   libsqlite3-dev         # evaluation archive
   libcli11-dev           # command line parsing

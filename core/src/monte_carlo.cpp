@@ -1,7 +1,10 @@
 #include "abuopt/core/monte_carlo.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
+#include <numeric>
 
 #include "abuopt/common/config_error.hpp"
 
@@ -20,7 +23,57 @@ MonteCarloSample make_sample(const MonteCarloStudy& s, std::size_t index, std::v
   return out;
 }
 
+// Key of a sample for the exchange symmetry: the sorted initial angles and the uncertain
+// parameters. Equal keys: the same physical start with the balls relabelled.
+std::vector<double> exchange_key(const MonteCarloSample& smp) {
+  std::vector<double> k(smp.beta0);
+  std::sort(k.begin(), k.end());
+  k.push_back(smp.friction_mu);
+  k.push_back(smp.imbalance_kgm);
+  k.push_back(smp.overrides.imbalance_angle_rad);
+  return k;
+}
+
+// same_as for every sample (identity when reuse is off or the balls differ).
+std::vector<std::size_t> reuse_map(const MonteCarloStudy& s, const std::vector<MonteCarloSample>& samples) {
+  std::vector<std::size_t> same(samples.size());
+  std::iota(same.begin(), same.end(), std::size_t{0});
+  if (!s.reuse_exchangeable || !balls_exchangeable(s.setup) || s.setup.abu.balls.size() < 2) return same;
+  std::map<std::vector<double>, std::size_t> first;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const auto [it, inserted] = first.emplace(exchange_key(samples[i]), i);
+    if (!inserted) same[i] = it->second;
+  }
+  return same;
+}
+
+// The outcome of `from` carried over to `to` (whose initial angles are a permutation of from's):
+// ball k of `to` started where ball p(k) of `from` did, so it ends where that one ended.
+RunOutcome permuted_outcome(const MonteCarloSample& from, const MonteCarloSample& to) {
+  RunOutcome o = from.outcome;
+  const std::size_t n = to.beta0.size();
+  std::vector<char> used(n, 0);
+  for (std::size_t k = 0; k < n; ++k) {
+    for (std::size_t q = 0; q < n; ++q) {
+      if (!used[q] && from.beta0[q] == to.beta0[k]) {
+        used[q] = 1;
+        if (q < from.outcome.beta_final.size()) o.beta_final[k] = from.outcome.beta_final[q];
+        break;
+      }
+    }
+  }
+  o.wall_time_s = 0;  // not paid again
+  return o;
+}
+
 }  // namespace
+
+bool balls_exchangeable(const SimulationSetup& setup) {
+  const auto& b = setup.abu.balls;
+  for (const auto& x : b)
+    if (x.mass_kg != b.front().mass_kg || x.diameter_m != b.front().diameter_m) return false;
+  return true;
+}
 
 InitialConditionDesign study_design(const MonteCarloStudy& s) {
   InitialConditionDesign d = s.design;
@@ -47,12 +100,31 @@ MonteCarloSample prepare_sample(const MonteCarloStudy& s, std::size_t index) {
   validate(s);
   if (index >= s.runs)
     throw ConfigError("run index", std::to_string(index), "must be < runs = " + std::to_string(s.runs));
-  return make_sample(s, index, initial_condition_at(study_design(s), index));
+  MonteCarloSample smp = make_sample(s, index, initial_condition_at(study_design(s), index));
+  if (s.reuse_exchangeable && balls_exchangeable(s.setup) && s.setup.abu.balls.size() >= 2) {
+    const std::vector<double> key = exchange_key(smp);
+    const InitialConditionDesign d = study_design(s);
+    for (std::size_t j = 0; j < index; ++j) {
+      if (exchange_key(make_sample(s, j, initial_condition_at(d, j))) == key) {
+        smp.reused = true;
+        smp.reused_from = j;
+        break;
+      }
+    }
+  }
+  return smp;
 }
 
 MonteCarloSample run_one(const MonteCarloStudy& s, std::size_t index, const SampleFunction& sample) {
   MonteCarloSample out = prepare_sample(s, index);
-  out.outcome = sample(out.beta0, out.overrides);
+  if (out.reused) {
+    // replay exactly what the study did: simulate the reused run and permute its outcome
+    MonteCarloSample from = prepare_sample(s, out.reused_from);
+    from.outcome = sample(from.beta0, from.overrides);
+    out.outcome = permuted_outcome(from, out);
+  } else {
+    out.outcome = sample(out.beta0, out.overrides);
+  }
   return out;
 }
 
@@ -64,15 +136,24 @@ MonteCarloResult run_monte_carlo(const MonteCarloStudy& s, const SampleFunction&
 
   MonteCarloResult result;
   result.samples.resize(s.runs);
+  for (std::size_t i = 0; i < s.runs; ++i) result.samples[i] = make_sample(s, i, std::move(points[i]));
+  const std::vector<std::size_t> same = reuse_map(s, result.samples);
+  std::vector<std::size_t> simulate;  // the runs that are paid for
+  for (std::size_t i = 0; i < s.runs; ++i) {
+    result.samples[i].reused = same[i] != i;
+    result.samples[i].reused_from = same[i];
+    if (same[i] == i) simulate.push_back(i);
+  }
   result.concurrency = runner.concurrency();
   runner.run(
-      s.runs,
-      [&](std::size_t i) {
-        MonteCarloSample smp = make_sample(s, i, std::move(points[i]));
+      simulate.size(),
+      [&](std::size_t k) {
+        MonteCarloSample& smp = result.samples[simulate[k]];
         smp.outcome = sample(smp.beta0, smp.overrides);
-        result.samples[i] = std::move(smp);
       },
       progress);
+  for (std::size_t i = 0; i < s.runs; ++i)
+    if (same[i] != i) result.samples[i].outcome = permuted_outcome(result.samples[same[i]], result.samples[i]);
   result.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
@@ -98,6 +179,7 @@ MonteCarloConfig read_monte_carlo_config(YamlReader& root, SimulationSetup setup
   st.seed = static_cast<std::uint64_t>(seed);
   st.design.seed = st.seed;
   st.design.random_shift = mc.get_bool_or("shift", true);
+  st.reuse_exchangeable = mc.get_bool_or("reuse_exchangeable", true);
   cfg.threads = static_cast<std::size_t>(mc.get_int_or("threads", 0, Rule::non_negative()));
   st.uncertain = read_uncertain_parameters(mc);
   mc.finish();

@@ -20,12 +20,19 @@ double mean_of(const std::vector<double>& v) {
   return s / static_cast<double>(v.size());
 }
 
-ResidualImbalanceStats imbalance_stats(std::vector<double> values, const std::vector<double>& thresholds) {
+ResidualImbalanceStats imbalance_stats(std::vector<double> values, const std::vector<double>& thresholds,
+                                       std::size_t distinct) {
   ResidualImbalanceStats r;
   r.count = values.size();
+  r.distinct = distinct;
   for (std::size_t i = 0; i < values.size(); ++i)
     if (values[i] >= thresholds[i]) ++r.mi_count;
-  const auto ci = wilson_interval(r.mi_count, r.count);
+  // Runs that reuse another's simulation (exchangeable balls) carry no new information: the
+  // interval is that of the proportion over the distinct runs.
+  const auto ci = distinct == r.count || r.count == 0
+                      ? wilson_interval(r.mi_count, r.count)
+                      : wilson_interval_p(static_cast<double>(r.mi_count) / static_cast<double>(r.count),
+                                          static_cast<double>(distinct));
   r.pct_mi_ci95 = {100.0 * ci.first, 100.0 * ci.second};
   if (values.empty()) {
     r.mean = r.min = r.max = r.median = r.p10 = r.p90 = r.p95 = r.pct_mi = kNaN;
@@ -98,8 +105,11 @@ double quantile_type7(const std::vector<double>& sorted, double p) {
 
 std::pair<double, double> wilson_interval(std::size_t k, std::size_t n, double z) {
   if (n == 0) return {kNaN, kNaN};
-  const double nn = static_cast<double>(n);
-  const double p = static_cast<double>(k) / nn;
+  return wilson_interval_p(static_cast<double>(k) / static_cast<double>(n), static_cast<double>(n), z);
+}
+
+std::pair<double, double> wilson_interval_p(double p, double nn, double z) {
+  if (!(nn > 0)) return {kNaN, kNaN};
   const double z2 = z * z;
   const double denom = 1.0 + z2 / nn;
   const double centre = (p + z2 / (2.0 * nn)) / denom;
@@ -121,6 +131,7 @@ MonteCarloStats compute_statistics(const std::vector<MonteCarloSample>& samples)
   MonteCarloStats st;
   st.runs = samples.size();
   std::vector<double> mag, rx, thresholds, settling, amplitude;
+  std::size_t distinct = 0;  // ok runs simulated for themselves
   for (const auto& s : samples) {
     const auto k = static_cast<std::size_t>(s.outcome.status);
     if (k < kRunStatusCount) ++st.status_counts[k];
@@ -129,6 +140,7 @@ MonteCarloStats compute_statistics(const std::vector<MonteCarloSample>& samples)
       continue;
     }
     ++st.ok;
+    distinct += !s.reused;
     mag.push_back(s.outcome.residual_imbalance_kgm);
     rx.push_back(s.outcome.residual_imbalance_x_kgm);
     thresholds.push_back(s.imbalance_kgm);
@@ -138,8 +150,9 @@ MonteCarloStats compute_statistics(const std::vector<MonteCarloSample>& samples)
     else
       ++st.not_settled;
   }
-  st.magnitude = imbalance_stats(mag, thresholds);
-  st.report_x = imbalance_stats(rx, thresholds);
+  st.distinct = distinct;
+  st.magnitude = imbalance_stats(mag, thresholds, distinct);
+  st.report_x = imbalance_stats(rx, thresholds, distinct);
   st.pct_lc = st.ok ? 100.0 * static_cast<double>(st.not_settled) / static_cast<double>(st.ok) : kNaN;
   st.settled = settling.size();
   st.settling_mean_s = mean_of(settling);
@@ -164,6 +177,7 @@ nlohmann::json to_json(const MonteCarloStats& s) {
   for (std::size_t k = 0; k < kRunStatusCount; ++k) counts[status_key(static_cast<RunStatus>(k))] = s.status_counts[k];
   return {{"runs", s.runs},
           {"ok", s.ok},
+          {"distinct_simulations", s.distinct},
           {"failed", s.failed},
           {"status_counts", counts},
           {"pct_lc", json_number(s.pct_lc)},
@@ -184,6 +198,8 @@ nlohmann::json to_json(const MonteCarloStats& s) {
 std::string format_summary(const MonteCarloStats& s) {
   std::ostringstream os;
   os << "runs " << s.runs << ": ok " << s.ok << ", failed " << s.failed;
+  if (s.distinct != s.ok)
+    os << " (" << s.distinct << " distinct: the others are the same starts with the identical balls exchanged)";
   if (s.failed) {
     os << " (";
     bool first = true;

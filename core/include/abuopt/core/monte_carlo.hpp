@@ -34,7 +34,17 @@ struct MonteCarloStudy {
   UncertainParameters uncertain;
   std::uint64_t seed = 0;   // stream of the uncertain parameters (the design has its own seed)
   std::size_t runs = 1024;  // Grid: must equal grid^balls
+  // Identical balls are exchangeable: a run whose initial angles are a permutation of an earlier
+  // run's (with the same uncertain parameters) has the same outcome with the final angles
+  // permuted alike. With this on (the default) such a run reuses the earlier simulation instead
+  // of paying for it again: the report's 32 x 32 grid holds 528 distinct starts of its 1024. The
+  // statistics weight every run as before (the report's figures count all grid points) but the
+  // %MI interval uses the number of distinct runs (monte_carlo_stats.hpp).
+  bool reuse_exchangeable = true;
 };
+
+// True when the setup's balls are all identical (same mass and diameter), i.e. exchangeable.
+bool balls_exchangeable(const SimulationSetup& setup);
 
 // The design the study actually uses: `design` with balls = setup.abu.balls.size() and, unless it
 // is a grid, count = runs.
@@ -47,6 +57,8 @@ void validate(const MonteCarloStudy& s, const std::string& path = "montecarlo");
 // One run's inputs and result.
 struct MonteCarloSample {
   std::size_t index = 0;
+  bool reused = false;        // true: the outcome is run `reused_from`'s with the balls exchanged
+  std::size_t reused_from = 0;
   std::vector<double> beta0;  // initial ball angles [rad]
   RunOverrides overrides;
   double friction_mu = 0;     // effective mu of this run (override or nominal)
@@ -65,6 +77,8 @@ struct MonteCarloResult {
 using SampleFunction = std::function<RunOutcome(const std::vector<double>& beta0, const RunOverrides& overrides)>;
 
 // The inputs of run `index` (outcome left default): for replaying or inspecting one run.
+// `reused`/`reused_from` are set as the engine sets them (the earliest run with a permutation of
+// these inputs).
 MonteCarloSample prepare_sample(const MonteCarloStudy& s, std::size_t index);
 
 // The engine with an injected per-sample function (tests, other models, surrogate screening).

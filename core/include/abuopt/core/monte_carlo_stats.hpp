@@ -16,7 +16,9 @@
 //   AbuParameters::imbalance_kgm(), or the run's own m_I when the imbalance mass is uncertain),
 //   with its 95 % Wilson score interval (z = 1.959963984540054):
 //     centre = (p + z^2/(2n)) / (1 + z^2/n),  half = z / (1 + z^2/n) sqrt(p (1 - p)/n + z^2/(4 n^2))
-//   (in percent).
+//   (in percent). When some runs reuse the simulation of an exchanged one (identical balls,
+//   MonteCarloStudy::reuse_exchangeable), p is still over all runs but n is the number of distinct
+//   (simulated) ok runs: the duplicates add no information.
 // %LC = 100 (#ok runs not settled at the end time) / n_ok.
 // Settling time: mean, median, max over the settled ok runs. Amplitude: max and mean of
 // max_amplitude_mm over the ok runs.
@@ -40,9 +42,12 @@ double quantile_type7(const std::vector<double>& sorted, double p);
 // 95 % (or other z) Wilson score interval of a proportion k/n, as fractions in [0, 1].
 // n = 0 gives {NaN, NaN}.
 std::pair<double, double> wilson_interval(std::size_t k, std::size_t n, double z = 1.959963984540054);
+// The same for a proportion p observed on an effective sample size n (not necessarily whole).
+std::pair<double, double> wilson_interval_p(double p, double n, double z = 1.959963984540054);
 
 struct ResidualImbalanceStats {
-  std::size_t count = 0;  // ok runs
+  std::size_t count = 0;     // ok runs
+  std::size_t distinct = 0;  // of which simulated for themselves (the rest reuse an exchanged run)
   double mean = 0, min = 0, max = 0, median = 0, p10 = 0, p90 = 0, p95 = 0;  // kg m
   std::size_t mi_count = 0;                   // runs with I_r >= I
   double pct_mi = 0;                          // 100 mi_count / count
@@ -57,6 +62,7 @@ std::string status_key(RunStatus s);
 struct MonteCarloStats {
   std::size_t runs = 0;
   std::size_t ok = 0;
+  std::size_t distinct = 0;  // ok runs simulated for themselves (MonteCarloStudy::reuse_exchangeable)
   std::size_t failed = 0;                                  // status != Ok
   std::array<std::size_t, kRunStatusCount> status_counts{};  // indexed by RunStatus
   ResidualImbalanceStats magnitude;  // |I_r| (RunOutcome::residual_imbalance_kgm)
