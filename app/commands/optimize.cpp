@@ -22,7 +22,6 @@
 #include "abuopt/optimizer/evaluation_archive.hpp"
 #include "abuopt/optimizer/minimize.hpp"
 #include "abuopt/optimizer/optimizer_options.hpp"
-#include "abuopt/optimizer/sao.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
 #include "commands/commands.hpp"
 
@@ -44,41 +43,16 @@ struct OptimizeArgs {
 
 struct LoadedConfig {
   problems::StartupProfileSettings settings;
-  opt::OptimizerOptions options;
-  opt::SaoOptions sao;
+  opt::OptimizerOptions options;  // with options.sao from `optimizer.sao` or the top-level `sao`
 };
-
-// The optimizer section, with "SAO" accepted as algorithm (read_optimizer_options knows the NLopt
-// and Ipopt names only; the SAO-specific keys are in the `sao` section).
-opt::OptimizerOptions read_optimizer_section(YamlReader& root) {
-  YamlReader section = root.child("optimizer");
-  if (section.present() && section.node()["algorithm"] && section.node()["algorithm"].IsScalar() &&
-      opt::is_sao_algorithm(section.node()["algorithm"].Scalar())) {
-    YAML::Node copy = YAML::Clone(section.node());
-    copy["algorithm"] = "cobyla";
-    YamlReader substitute(copy, section.path());
-    opt::OptimizerOptions o = opt::read_optimizer_options(substitute);
-    o.algorithm = "SAO";
-    return o;
-  }
-  return opt::read_optimizer_options(section);
-}
 
 LoadedConfig load_config(const OptimizeArgs& a) {
   LoadedConfig c;
   YamlReader root = YamlReader::load_file(a.config);
   c.settings = problems::read_startup_profile_settings(root);
-  c.options = read_optimizer_section(root);
-  const bool sao = opt::is_sao_algorithm(c.options.algorithm);
-  if (root.has("sao")) {
-    YamlReader s = root.child("sao");
-    if (!sao)
-      throw ConfigError("sao", yaml_value_text(s.node()),
-                        "is only used with optimizer.algorithm: SAO (algorithm is " + c.options.algorithm + ")");
-    c.sao = opt::read_sao_options(s);
-  } else {
-    root.child("sao");
-  }
+  YamlReader optimizer = root.child("optimizer");
+  YamlReader sao = root.child("sao");
+  c.options = opt::read_optimizer_options(optimizer, &sao);
   root.finish();
   if (a.max_evaluations) {
     if (*a.max_evaluations < 1)
@@ -89,7 +63,7 @@ LoadedConfig load_config(const OptimizeArgs& a) {
     if (*a.threads < 0) throw ConfigError("--threads", std::to_string(*a.threads), "must be >= 0 (0 = all cores)");
     c.settings.threads = static_cast<std::size_t>(*a.threads);
   }
-  if (!sao) c.options.validate();
+  c.options.validate();
   return c;
 }
 
@@ -259,7 +233,7 @@ int run_optimize(const OptimizeArgs& a) {
   const std::string id = problem.identity();
   opt::EvaluationArchive archive((out / "archive.sqlite").string(), id);
   opt::ArchivedProblem archived(problem, archive);
-  cfg.sao.archive = &archive;
+  cfg.options.sao.archive = &archive;  // SAO: archived points inform its surrogates
 
   // Progress to stdout, or to stderr with --json (stdout then holds the JSON alone).
   std::ostream& log = a.json ? std::cerr : std::cout;
@@ -297,7 +271,7 @@ int run_optimize(const OptimizeArgs& a) {
     return true;
   };
 
-  opt::OptimizationResult r = opt::minimize_any(archived, cfg.options, cfg.sao, {}, progress);
+  opt::OptimizationResult r = opt::minimize(archived, cfg.options, {}, progress);
   log << "\n" << r.brief_report() << "\n";
   if (!r.message.empty()) log << "  " << r.message << "\n";
 

@@ -129,7 +129,7 @@ TEST(OptimizeCli, BadConfigsGiveOneClearMessageAndStatus2) {
        "no free variable"},
       {design + "objective: {kind: mean, definiton: report_x}\n", "",
        "objective.definiton = report_x: unknown key (misspelt, or not valid here)"},
-      {design + "sao: {initial_radius: 0.2}\n", "", "sao = {initial_radius: 0.2}: is only used with optimizer.algorithm: SAO"},
+      {design + "sao: {initial_radius: 0.2}\n", "", "sao = <section>: only used with optimizer.algorithm: SAO"},
       {design, "--max-evaluations 0", "--max-evaluations = 0: must be >= 1"},
   };
   int i = 0;
