@@ -319,6 +319,17 @@ int run_optimize(const OptimizeArgs& a) {
                  {"profile", profile_json(problem.profile_at(r.x))}};
     log << "best design: " << vector_text(vars, r.x) << "\n  profile " << profile_text(problem.profile_at(r.x))
         << "\n  objective " << format_number(r.objective) << (r.feasible ? " (feasible)" : " (NOT feasible)") << "\n";
+    if (st.constraints.penalty_weight > 0) {
+      // Penalty form: "feasible" above only means "no declared constraints"; show the real ones.
+      log << "  penalty form (weight " << format_number(st.constraints.penalty_weight) << "), relative constraints:";
+      bool any = false;
+      for (const auto& [k, v] : r.metrics)
+        if (k.rfind("g_", 0) == 0) {
+          log << " " << k.substr(2) << " = " << std::setprecision(4) << v << (v > 0 ? " (violated)" : "");
+          any = true;
+        }
+      log << (any ? "" : " none") << "\n";
+    }
   } else {
     log << "no evaluation finished: nothing to report\n";
   }
