@@ -117,15 +117,7 @@ std::pair<double, double> wilson_interval_p(double p, double nn, double z) {
   return {std::max(0.0, centre - half), std::min(1.0, centre + half)};
 }
 
-std::string status_key(RunStatus s) {
-  switch (s) {
-    case RunStatus::Ok: return "ok";
-    case RunStatus::SolverFailure: return "solver_failure";
-    case RunStatus::ChatterLimit: return "chatter_limit";
-    case RunStatus::StepLimit: return "step_limit";
-  }
-  return "unknown";
-}
+std::string status_key(RunStatus s) { return to_string(s); }  // outcome.hpp's names
 
 MonteCarloStats compute_statistics(const std::vector<MonteCarloSample>& samples) {
   MonteCarloStats st;
