@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <limits>
 #include <map>
 #include <memory>
@@ -19,6 +20,7 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/optimizer/evaluation_archive.hpp"
+#include "abuopt/optimizer/sao_intervening.hpp"
 #include "abuopt/surrogate/doe.hpp"
 #include "abuopt/surrogate/kriging.hpp"
 #include "abuopt/surrogate/response_surface.hpp"
@@ -69,6 +71,7 @@ struct Models {
   double f_offset = 0;
   std::vector<double> g_offset, h_offset;
   std::string basis;
+  std::string forms;  // intervening form per response, one letter each (l, r, e): "f:l g:r"
 
   std::size_t n_g() const { return gm.size(); }
   std::size_t n_h() const { return hm.size(); }
@@ -201,7 +204,7 @@ class SaoRun {
   bool fill_region(const std::string& basis);  // false: stopped
   bool minimal_design() const;
   bool repair_geometry();  // false: stopped
-  std::optional<Models> fit(const std::string& basis) const;
+  std::optional<Models> fit(const std::string& basis);
   Eigen::VectorXd solve_subproblem(const Models& models, bool& feasibility_phase);
   Eigen::VectorXd run_nlopt(const Models& models, bool feasibility_phase, const Eigen::VectorXd& start,
                             const Eigen::VectorXd& lo, const Eigen::VectorXd& hi) const;
@@ -223,6 +226,9 @@ class SaoRun {
   double radius_ = 0.1;
   double mu_ = 1.0;
   bool feasibility_phase_ = false;
+  // the last intervening choice of every response (objective, inequalities, equalities; no
+  // model): kept when too few points exist to compare the forms again
+  std::vector<InterveningChoice> last_choice_;
 };
 
 KnownPoint SaoRun::make_point(const Eigen::VectorXd& z, const Evaluation& e) const {
@@ -463,11 +469,10 @@ std::unique_ptr<surrogate::Surrogate> SaoRun::make_model(const std::string& basi
   return surrogate::make_surrogate(basis);
 }
 
-std::optional<Models> SaoRun::fit(const std::string& requested) const {
+std::optional<Models> SaoRun::fit(const std::string& requested) {
   std::vector<Eigen::VectorXd> s;
   std::vector<double> w;
   std::vector<const KnownPoint*> pts;
-  int in_region_count = 0;
   for (const KnownPoint& p : known_) {
     if (!p.ok) continue;
     const Eigen::VectorXd sp = to_s(p.z);
@@ -476,17 +481,33 @@ std::optional<Models> SaoRun::fit(const std::string& requested) const {
     s.push_back(sp);
     w.push_back(d <= 1 + 1e-9 ? 1.0 : 1.0 / std::pow(d, 4));
     pts.push_back(&p);
-    if (d <= 1 + 1e-9) ++in_region_count;
   }
   const int m = static_cast<int>(s.size());
   if (m < 2) return std::nullopt;
-  Eigen::MatrixXd X(m, n_);
-  Eigen::VectorXd W(m);
+  InterveningData data;
+  data.S.resize(m, n_);
+  data.weights.resize(m);
   for (int i = 0; i < m; ++i) {
-    X.row(i) = s[i].transpose();
-    W[i] = w[i];
+    data.S.row(i) = s[i].transpose();
+    data.weights[i] = w[i];
   }
-  using surrogate::Basis;
+  // the original variables of the centre and the trust region's half-width in them
+  data.centre.resize(n_);
+  data.step.resize(n_);
+  data.allowed.resize(n_);
+  for (int i = 0; i < n_; ++i) {
+    const Variable& v = variables_[i];
+    data.centre[i] = v.lower + centre_z_[i] * (v.upper - v.lower);
+    data.step[i] = radius_ * (v.upper - v.lower);
+    data.allowed[i] = intervening_allowed(v.lower, v.upper);
+  }
+  const std::size_t responses = 1 + m_ineq_ + m_eq_;
+  last_choice_.resize(responses);
+  auto form_of = [&](std::size_t k) {
+    const std::string& specific = k == 0 ? sao_.intervening_objective : sao_.intervening_constraints;
+    return specific.empty() ? sao_.intervening : specific;
+  };
+
   std::vector<std::string> order;
   if (requested == "auto") order = {"quadratic", "pure_quadratic", "linear"};
   else if (requested == "kriging") order = {"kriging", "linear"};
@@ -496,22 +517,35 @@ std::optional<Models> SaoRun::fit(const std::string& requested) const {
     try {
       Models models;
       models.basis = basis;
-      auto fit_one = [&](const std::function<double(const KnownPoint&)>& value) {
+      std::vector<InterveningChoice> choices(responses);
+      auto fit_one = [&](std::size_t k, const std::function<double(const KnownPoint&)>& value) {
         Eigen::VectorXd y(m);
         for (int i = 0; i < m; ++i) y[i] = value(*pts[i]);
         if (basis == "kriging") {
-          // kriging interpolates: region points and neighbours alike
-          auto model = make_model(basis);
-          model->fit(X, y);
-          return model;
+          // kriging interpolates: region points and neighbours alike; intervening variables only
+          // when asked for explicitly (no leave-one-out error to choose them by)
+          const bool reciprocal = form_of(k) == "reciprocal";
+          Eigen::VectorXd p = Eigen::VectorXd::Constant(n_, reciprocal ? -1.0 : 1.0);
+          auto model = std::make_unique<InterveningSurrogate>(
+              reciprocal ? InterveningMap(data.centre, data.step, p, data.allowed) : InterveningMap::identity(n_),
+              make_model(basis), reciprocal ? "reciprocal" : "linear");
+          model->fit(data.S, y);
+          choices[k].form = model->form();
+          choices[k].exponents = model->map().exponents();
+          return std::unique_ptr<surrogate::Surrogate>(std::move(model));
         }
-        auto rs = std::make_unique<surrogate::ResponseSurface>(surrogate::basis_from_string(basis));
-        rs->fit(X, y, W);
-        return std::unique_ptr<surrogate::Surrogate>(std::move(rs));
+        const InterveningChoice* previous = last_choice_[k].exponents.size() == n_ ? &last_choice_[k] : nullptr;
+        InterveningChoice c = fit_intervening(form_of(k), surrogate::basis_from_string(basis), data, y, previous);
+        choices[k].form = c.form;
+        choices[k].exponents = c.exponents;
+        choices[k].loo_error = c.loo_error;
+        return std::unique_ptr<surrogate::Surrogate>(std::move(c.model));
       };
-      models.fm = fit_one([](const KnownPoint& p) { return p.f; });
-      for (std::size_t i = 0; i < m_ineq_; ++i) models.gm.push_back(fit_one([i](const KnownPoint& p) { return p.g[i]; }));
-      for (std::size_t j = 0; j < m_eq_; ++j) models.hm.push_back(fit_one([j](const KnownPoint& p) { return p.h[j]; }));
+      models.fm = fit_one(0, [](const KnownPoint& p) { return p.f; });
+      for (std::size_t i = 0; i < m_ineq_; ++i)
+        models.gm.push_back(fit_one(1 + i, [i](const KnownPoint& p) { return p.g[i]; }));
+      for (std::size_t j = 0; j < m_eq_; ++j)
+        models.hm.push_back(fit_one(1 + m_ineq_ + j, [j](const KnownPoint& p) { return p.h[j]; }));
       models.g_offset.assign(m_ineq_, 0.0);
       models.h_offset.assign(m_eq_, 0.0);
       const KnownPoint& c = known_[centre_];
@@ -520,6 +554,10 @@ std::optional<Models> SaoRun::fit(const std::string& requested) const {
         models.f_offset = c.f - models.fm->value(zero);
         for (std::size_t i = 0; i < m_ineq_; ++i) models.g_offset[i] = c.g[i] - models.gm[i]->value(zero);
         for (std::size_t j = 0; j < m_eq_; ++j) models.h_offset[j] = c.h[j] - models.hm[j]->value(zero);
+      }
+      for (std::size_t k = 0; k < responses; ++k) {
+        models.forms += (k == 0 ? "f:" : k <= m_ineq_ ? " g:" : " h:") + choices[k].form.substr(0, 1);
+        last_choice_[k] = std::move(choices[k]);
       }
       return models;
     } catch (const std::exception&) {
@@ -730,8 +768,8 @@ void SaoRun::run(const std::vector<double>& x0) {
       centre_z_ = known_[centre_].z;
     }
     if (std::getenv("ABUOPT_SAO_TRACE"))
-      std::fprintf(stderr, "it %ld evals %ld basis %s phase1 %d r %.3g->%.3g rho %.3g pred %.3g act %.3g mu %.3g step %.3f fc %.8g\n",
-                   iterations, driver_.evaluations(), models->basis.c_str(), phase1 ? 1 : 0, old_radius, radius_, rho,
+      std::fprintf(stderr, "it %ld evals %ld basis %s [%s] phase1 %d r %.3g->%.3g rho %.3g pred %.3g act %.3g mu %.3g step %.3f fc %.8g\n",
+                   iterations, driver_.evaluations(), models->basis.c_str(), models->forms.c_str(), phase1 ? 1 : 0, old_radius, radius_, rho,
                    predicted, actual, mu_, step, known_[centre_].f);
     const bool progress = actual > sao_.stall_tolerance * std::max(1.0, std::fabs(phi_c));
     stalled = progress ? 0 : stalled + 1;

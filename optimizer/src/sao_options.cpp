@@ -7,6 +7,7 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/optimizer/problem.hpp"
+#include "abuopt/optimizer/sao_intervening.hpp"
 
 namespace abuopt::opt {
 
@@ -50,6 +51,11 @@ void SaoOptions::validate(const std::string& p) const {
   require_choice(p, "surrogate", surrogate, surrogate_choices());
   require_choice(p, "doe", doe, doe_choices());
   require_choice(p, "subproblem_solver", subproblem_solver, solver_choices());
+  require_choice(p, "intervening", intervening, intervening_choices());
+  if (!intervening_objective.empty())
+    require_choice(p, "intervening_objective", intervening_objective, intervening_choices());
+  if (!intervening_constraints.empty())
+    require_choice(p, "intervening_constraints", intervening_constraints, intervening_choices());
   require(doe_points >= 0, p, "doe_points", doe_points, "must be >= 0 (0: automatic)");
   require(std::isfinite(doe_points_factor) && doe_points_factor >= 1 && doe_points_factor <= 10, p,
           "doe_points_factor", doe_points_factor, "must be in [1, 10]");
@@ -110,6 +116,11 @@ SaoOptions read_sao_options(YamlReader& r) {
   o.rho_shrink = r.get_double_or("rho_shrink", o.rho_shrink);
   o.rho_expand_low = r.get_double_or("rho_expand_low", o.rho_expand_low);
   o.rho_expand_high = r.get_double_or("rho_expand_high", o.rho_expand_high);
+  o.intervening = r.get_choice_or("intervening", o.intervening, intervening_choices());
+  o.intervening_objective = r.get_choice_or("intervening_objective", o.intervening, intervening_choices());
+  o.intervening_constraints = r.get_choice_or("intervening_constraints", o.intervening, intervening_choices());
+  if (o.intervening_objective == o.intervening) o.intervening_objective.clear();
+  if (o.intervening_constraints == o.intervening) o.intervening_constraints.clear();
   o.correction = r.get_bool_or("correction", o.correction);
   o.short_step = r.get_double_or("short_step", o.short_step);
   o.penalty_initial = r.get_double_or("penalty_initial", o.penalty_initial);

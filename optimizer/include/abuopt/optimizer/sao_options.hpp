@@ -58,6 +58,17 @@ struct SaoOptions {
   double rho_expand_low = 0.75;  // rho in [rho_expand_low, rho_expand_high] and the step on
   double rho_expand_high = 1.25; // the boundary: expand
 
+  // Intervening variables of the surrogates (sao_intervening.hpp): each response is a polynomial
+  // in y_i = x_i (linear), 1/x_i (reciprocal) or x_i^p_i with p_i fitted in [-3, 3] (exponential)
+  // of the original variables x; auto: per response and iteration, the form with the smallest
+  // weighted leave-one-out (PRESS) error on the fit zone (linear on ties). A variable whose lower
+  // bound is <= 0 always stays linear. Response surfaces only (kriging: reciprocal if asked, else
+  // linear). auto, linear, reciprocal, exponential.
+  std::string intervening = "auto";
+  // Overrides for the objective and for every constraint ("": as `intervening`).
+  std::string intervening_objective;
+  std::string intervening_constraints;
+
   // Zeroth-order additive correction (Dakota's `correction additive zeroth_order`): every
   // surrogate is shifted to match the true value at the centre.
   bool correction = true;
