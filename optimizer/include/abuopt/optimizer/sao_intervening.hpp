@@ -16,9 +16,9 @@
 // trust region never leaves the bounds): for any other variable p is forced to 1.
 //
 // Forms: linear (every p = 1), reciprocal (every allowed p = -1), exponential (p_i fitted per
-// variable on [-3, 3] by coordinate search over a grid of step 0.5, minimising the weighted
-// leave-one-out error), auto (the form with the smallest weighted leave-one-out error, see
-// choose_intervening()).
+// variable on [-3, 3] by coordinate search over a grid of step 0.5, at most 3 sweeps, minimising
+// the weighted leave-one-out error), auto (linear unless a transformed form has a much smaller
+// weighted leave-one-out error, see fit_intervening()).
 #include <memory>
 #include <string>
 #include <vector>
@@ -106,13 +106,13 @@ struct InterveningChoice {
 
 // Fits one response y with polynomial `basis` in the intervening variables of `requested`
 // (linear, reciprocal, exponential, auto). Selection (auto) and the exponent search (exponential)
-// minimise weighted_press() with `basis`; when it is not measurable for any candidate (as many
-// points as terms) the next simpler basis (pure_quadratic, then linear) is used to compare them,
-// and when not even the linear one is, the `previous` choice of this response is kept (its form
-// and exponents), else linear. auto prefers linear on ties, takes reciprocal only when its error is
-// below the linear one, and exponential only when its error is below half of the better fixed form
-// (it has n fitted exponents more). Throws std::invalid_argument when the basis cannot be fitted
-// (too few points, rank-deficient).
+// minimise weighted_press() of a LINEAR model in the candidate's variables (the form in which the
+// response is most nearly linear; measurable from n + 2 points on); with fewer points the
+// `previous` choice of this response is kept (its form and exponents), else linear. auto prefers
+// linear: reciprocal only when its error is below 1/4 of the linear one, exponential only when its
+// error is below 1/50 of the better fixed form (it has n fitted exponents more). The final model
+// has `basis`. Throws std::invalid_argument when the basis cannot be fitted (too few points,
+// rank-deficient).
 InterveningChoice fit_intervening(const std::string& requested, surrogate::Basis basis, const InterveningData& data,
                                   const Eigen::VectorXd& y, const InterveningChoice* previous = nullptr);
 

@@ -60,8 +60,9 @@ struct SaoOptions {
 
   // Intervening variables of the surrogates (sao_intervening.hpp): each response is a polynomial
   // in y_i = x_i (linear), 1/x_i (reciprocal) or x_i^p_i with p_i fitted in [-3, 3] (exponential)
-  // of the original variables x; auto: per response and iteration, the form with the smallest
-  // weighted leave-one-out (PRESS) error on the fit zone (linear on ties). A variable whose lower
+  // of the original variables x; auto: per response and iteration, linear unless reciprocal or
+  // exponential has a much smaller weighted leave-one-out (PRESS) error of a linear model on the
+  // fit zone (1/4, resp. 1/50 of it; docs/sao.md). A variable whose lower
   // bound is <= 0 always stays linear. Response surfaces only (kriging: reciprocal if asked, else
   // linear). auto, linear, reciprocal, exponential.
   std::string intervening = "auto";
