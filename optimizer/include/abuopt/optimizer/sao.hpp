@@ -20,7 +20,10 @@
 //      `reuse_distance` (in s), farthest-from-known first.
 //   3. Surrogates of f, every g_i and every h_j, fitted by weighted least squares in s on the
 //      points of R (weight 1) and of the rest of the fit zone (weight 1/|s|_inf^4). Basis "auto":
-//      quadratic if there are enough points, else pure quadratic, else linear.
+//      quadratic if there are enough points, else pure quadratic, else linear. Each response in its
+//      own intervening variables (sao_intervening.hpp; option intervening: linear, reciprocal,
+//      fitted exponents, auto by weighted leave-one-out error); the sub-problem sees the composed
+//      models and their chain-rule gradients.
 //   4. Sub-problem: minimise f^(s) s.t. g^(s) <= 0, h^(s) = 0, s in R, with NLopt SLSQP and
 //      analytic surrogate gradients, from the centre and from the best known point in R. If the
 //      surrogate constraints cannot be met in R, the sub-problem minimises the predicted
