@@ -4,9 +4,12 @@
 //   build-mc/bench/monte_carlo_bench                       # all benchmarks, 1024 runs each
 //   ABUOPT_BENCH_RUNS=256 build-mc/bench/monte_carlo_bench  # quicker: 256 random (LHS) runs
 //
-// BM_MonteCarloFinalProfile/threads:T  wall time of one study with T worker threads (0 = all
-//     cores); counters runs_per_s and s_per_run (wall time per run, all threads together).
-// BM_ParallelEfficiency  the same study on 1 and then 2 threads; counters t1_s, t2_s,
+// BM_MonteCarloFinalProfile/threads:T/reuse:R  wall time of one study with T worker threads
+//     (0 = all cores); R = 1: exchanged starts of the identical balls simulated once (the default
+//     of every study: 528 simulations for the 1024-run grid), R = 0: every run simulated (1024
+//     simulations); counters runs_per_s, s_per_run (wall time per run, all threads together) and
+//     simulations.
+// BM_ParallelEfficiency  the study without reuse on 1 and then 2 threads; counters t1_s, t2_s,
 //     speedup = t1/t2 and efficiency = speedup / 2 (1.0 = perfect scaling). On a machine shared
 //     with other jobs the figures are lower bounds.
 #include <benchmark/benchmark.h>
@@ -29,8 +32,9 @@ std::size_t bench_runs() {
   return 1024;
 }
 
-MonteCarloStudy final_profile_study() {
+MonteCarloStudy final_profile_study(bool reuse = true) {
   MonteCarloStudy s;
+  s.reuse_exchangeable = reuse;
   s.setup.profile = StartupProfile::report_final();
   s.setup.abu.friction_mu = 0.02;
   s.runs = bench_runs();
@@ -52,35 +56,39 @@ double run_study(const MonteCarloStudy& s, const SampleFunction& f, std::size_t 
 }
 
 void BM_MonteCarloFinalProfile(benchmark::State& state) {
-  const MonteCarloStudy s = final_profile_study();
+  const MonteCarloStudy s = final_profile_study(state.range(1) != 0);
   const SampleFunction f = simulator_sample_function(s.setup);
   const auto threads = static_cast<std::size_t>(state.range(0));
   double wall = 0;
-  std::size_t failed = 0;
+  std::size_t failed = 0, simulations = 0;
   for (auto _ : state) {
     ThreadPoolRunner runner(threads);
     const MonteCarloResult r = run_monte_carlo(s, f, runner);
     wall = r.wall_time_s;
-    failed = compute_statistics(r.samples).failed;
+    const MonteCarloStats st = compute_statistics(r.samples);
+    failed = st.failed;
+    simulations = st.distinct + st.failed;
     state.SetIterationTime(wall);
     state.counters["workers"] = static_cast<double>(runner.concurrency());
   }
   state.counters["runs"] = static_cast<double>(s.runs);
   state.counters["failed"] = static_cast<double>(failed);
+  state.counters["simulations"] = static_cast<double>(simulations);
   state.counters["runs_per_s"] = static_cast<double>(s.runs) / wall;
   state.counters["s_per_run"] = wall / static_cast<double>(s.runs);
 }
 BENCHMARK(BM_MonteCarloFinalProfile)
-    ->ArgName("threads")
-    ->Arg(0)
-    ->Arg(1)
-    ->Arg(2)
+    ->ArgNames({"threads", "reuse"})
+    ->Args({0, 1})
+    ->Args({0, 0})
+    ->Args({1, 0})
+    ->Args({2, 0})
     ->Iterations(1)
     ->UseManualTime()
     ->Unit(benchmark::kSecond);
 
 void BM_ParallelEfficiency(benchmark::State& state) {
-  const MonteCarloStudy s = final_profile_study();
+  const MonteCarloStudy s = final_profile_study(false);
   const SampleFunction f = simulator_sample_function(s.setup);
   double t1 = 0, t2 = 0;
   for (auto _ : state) {

@@ -448,7 +448,9 @@ CaseSummary summarize_case(const ReproductionTable& table, const ReproductionCas
   s.settling_max_s = st.settling_max_s;
   s.amplitude_max_mm = st.amplitude_max_mm;
   s.wall_time_s = result.wall_time_s;
-  // Standard error of the mean I_r,x over the ok runs (sample standard deviation / sqrt(n)).
+  // Standard error of the mean I_r,x over the ok runs: sample standard deviation / sqrt(n_eff),
+  // n_eff = the distinct runs (exchanged starts of identical balls repeat a run: no new
+  // information, as for the Wilson interval of %MI).
   double sum = 0, sum2 = 0;
   std::size_t n = 0;
   for (const MonteCarloSample& m : result.samples)
@@ -458,10 +460,11 @@ CaseSummary summarize_case(const ReproductionTable& table, const ReproductionCas
       sum2 += v * v;
       ++n;
     }
-  if (n >= 2) {
+  const std::size_t n_eff = st.distinct;
+  if (n >= 2 && n_eff >= 2) {
     const double mean = sum / static_cast<double>(n);
     const double var = std::max(0.0, (sum2 - static_cast<double>(n) * mean * mean) / static_cast<double>(n - 1));
-    s.sem_x = std::sqrt(var / static_cast<double>(n));
+    s.sem_x = std::sqrt(var / static_cast<double>(n_eff));
   } else {
     s.sem_x = std::numeric_limits<double>::quiet_NaN();
   }
