@@ -280,3 +280,24 @@ TEST(Simulator, CoincidentBallsRunWithoutFailure) {
   }
   EXPECT_EQ(failed, 0);
 }
+
+TEST(Simulator, ChatterGuardEndsARunAsACountedOutcome) {
+  // More than chatter_events transitions within chatter_window_s: status chatter_limit, with
+  // the state reached so far; no exception. A typical final-profile run has ~15 events in 38 s.
+  SimulationSetup s;
+  s.options.chatter_events = 3;
+  s.options.chatter_window_s = 100.0;
+  Simulator sim(s);
+  RunOutcome o;
+  ASSERT_NO_THROW(o = sim.run({0.1, 0.2}));
+  EXPECT_EQ(o.status, RunStatus::ChatterLimit);
+  EXPECT_EQ(o.events, 4);
+  EXPECT_FALSE(o.settled);
+  EXPECT_NE(o.message.find("stick/slip events within"), std::string::npos) << o.message;
+  SimulationSetup t;
+  t.options.max_events = 2;
+  Simulator sim2(t);
+  const RunOutcome o2 = sim2.run({0.1, 0.2});
+  EXPECT_EQ(o2.status, RunStatus::ChatterLimit);
+  EXPECT_EQ(o2.events, 3);
+}
