@@ -48,6 +48,8 @@ OptimizationResult minimize_any(Problem& problem, const OptimizerOptions& option
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Residual RMS below this fraction of the responses' spread on the fit zone: not noise.
+constexpr double kNoiseFraction = 0.1;
 
 struct OptDeleter {
   void operator()(nlopt_opt o) const { nlopt_destroy(o); }
@@ -72,6 +74,15 @@ struct Models {
   std::vector<double> g_offset, h_offset;
   std::string basis;
   std::string forms;  // intervening form per response, one letter each (l, r, e): "f:l g:r"
+  // Noise level of every response (objective, inequalities, equalities) seen by this fit: the
+  // weighted residual RMS of the least-squares fit with the degrees-of-freedom correction
+  // sqrt(sum w e^2 / sum w * m / (m - p)); 0 when the fit interpolates (m <= p) or for kriging.
+  // An upper bound of the noise (it includes the lack of fit, which vanishes as r shrinks on a
+  // smooth response and does not on a noisy one).
+  std::vector<double> noise;
+  // The same residual RMS relative to the responses' weighted standard deviation on the fit zone
+  // (1: the model explains nothing; ~0: smooth at this scale).
+  std::vector<double> noise_fraction;
 
   std::size_t n_g() const { return gm.size(); }
   std::size_t n_h() const { return hm.size(); }
@@ -209,6 +220,7 @@ class SaoRun {
   Eigen::VectorXd run_nlopt(const Models& models, bool feasibility_phase, const Eigen::VectorXd& start,
                             const Eigen::VectorXd& lo, const Eigen::VectorXd& hi) const;
   void update_penalty(const Models& models, const Eigen::VectorXd& s);
+  double merit_noise(const Models& models, bool phase1) const;
   std::unique_ptr<surrogate::Surrogate> make_model(const std::string& basis) const;
 
   Problem& problem_;
@@ -229,6 +241,9 @@ class SaoRun {
   // the last intervening choice of every response (objective, inequalities, equalities; no
   // model): kept when too few points exist to compare the forms again
   std::vector<InterveningChoice> last_choice_;
+  // per response: (radius, residual RMS) of every fit that had degrees of freedom to spare
+  std::vector<std::vector<std::pair<double, double>>> noise_history_;
+  void confirm_noise(Models& models);
 };
 
 KnownPoint SaoRun::make_point(const Eigen::VectorXd& z, const Evaluation& e) const {
@@ -518,6 +533,7 @@ std::optional<Models> SaoRun::fit(const std::string& requested) {
       Models models;
       models.basis = basis;
       std::vector<InterveningChoice> choices(responses);
+      std::vector<double> noise(responses, 0.0), noise_fraction(responses, 0.0);
       auto fit_one = [&](std::size_t k, const std::function<double(const KnownPoint&)>& value) {
         Eigen::VectorXd y(m);
         for (int i = 0; i < m; ++i) y[i] = value(*pts[i]);
@@ -536,6 +552,23 @@ std::optional<Models> SaoRun::fit(const std::string& requested) {
         }
         const InterveningChoice* previous = last_choice_[k].exponents.size() == n_ ? &last_choice_[k] : nullptr;
         InterveningChoice c = fit_intervening(form_of(k), surrogate::basis_from_string(basis), data, y, previous);
+        const int p = surrogate::terms_count(surrogate::basis_from_string(basis), n_);
+        if (m > p) {
+          double wsum = 0, sse = 0, mean = 0;
+          for (int i = 0; i < m; ++i) {
+            const double e = y[i] - c.model->value(data.S.row(i).transpose());
+            sse += w[i] * e * e;
+            wsum += w[i];
+            mean += w[i] * y[i];
+          }
+          mean /= wsum;
+          double var = 0;
+          for (int i = 0; i < m; ++i) var += w[i] * (y[i] - mean) * (y[i] - mean);
+          const double sigma = std::sqrt(sse / wsum * m / (m - p));
+          const double sd = std::sqrt(var / wsum);
+          noise[k] = std::isfinite(sigma) ? sigma : 0.0;
+          noise_fraction[k] = sd > 0 && std::isfinite(sigma) ? std::min(1.0, sigma / sd) : 0.0;
+        }
         choices[k].form = c.form;
         choices[k].exponents = c.exponents;
         choices[k].loo_error = c.loo_error;
@@ -555,6 +588,8 @@ std::optional<Models> SaoRun::fit(const std::string& requested) {
         for (std::size_t i = 0; i < m_ineq_; ++i) models.g_offset[i] = c.g[i] - models.gm[i]->value(zero);
         for (std::size_t j = 0; j < m_eq_; ++j) models.h_offset[j] = c.h[j] - models.hm[j]->value(zero);
       }
+      models.noise = std::move(noise);
+      models.noise_fraction = std::move(noise_fraction);
       for (std::size_t k = 0; k < responses; ++k) {
         models.forms += (k == 0 ? "f:" : k <= m_ineq_ ? " g:" : " h:") + choices[k].form.substr(0, 1);
         last_choice_[k] = std::move(choices[k]);
@@ -687,6 +722,41 @@ void SaoRun::update_penalty(const Models& models, const Eigen::VectorXd& s) {
   if (need > mu_ && need < 1e12) mu_ = need;
 }
 
+// The noise level of the merit at the centre as the models see it: the objective's (outside the
+// feasibility phase) plus mu times that of every constraint that is violated or within two noise
+// levels of its bound (the others do not enter the L1 violation).
+// Lack of fit or noise? The residual RMS of a fit on a smooth response shrinks with the region
+// (as r^2 for a linear model, faster for quadratic ones); on a noisy one it does not. A response's
+// residual RMS is taken as its noise level only when an earlier fit on a region at least twice as
+// wide had a residual RMS at most twice the current one, and the residuals are at least
+// kNoiseFraction of the responses' spread on the fit zone; otherwise its noise is 0 (the classical
+// ratio test applies). Records the current fit in the history.
+void SaoRun::confirm_noise(Models& models) {
+  const std::size_t responses = models.noise.size();
+  noise_history_.resize(responses);
+  for (std::size_t k = 0; k < responses; ++k) {
+    const double now = models.noise[k];
+    bool confirmed = false;
+    for (const auto& [r, sigma] : noise_history_[k])
+      if (r >= 2 * radius_ * (1 - 1e-9) && sigma <= 2 * now) confirmed = now > 0;
+    if (now > 0) noise_history_[k].emplace_back(radius_, now);
+    // a model that explains all but a small part of the response's spread on the zone: smooth
+    if (models.noise_fraction[k] < kNoiseFraction) confirmed = false;
+    if (!confirmed) models.noise[k] = 0;
+  }
+}
+
+double SaoRun::merit_noise(const Models& models, bool phase1) const {
+  if (models.noise.size() != 1 + m_ineq_ + m_eq_) return 0.0;
+  const KnownPoint& c = known_[centre_];
+  if (!c.ok) return 0.0;
+  double v = 0;
+  for (std::size_t i = 0; i < m_ineq_; ++i)
+    if (c.g[i] > -2 * models.noise[1 + i]) v += models.noise[1 + i];
+  for (std::size_t j = 0; j < m_eq_; ++j) v += models.noise[1 + m_ineq_ + j];
+  return phase1 ? v : models.noise[0] + mu_ * v;
+}
+
 void SaoRun::run(const std::vector<double>& x0) {
   load_archive();
   radius_ = sao_.initial_radius;
@@ -727,6 +797,7 @@ void SaoRun::run(const std::vector<double>& x0) {
       ++stalled;
       continue;
     }
+    confirm_noise(*models);
     bool phase1 = false;
     const Eigen::VectorXd s = solve_subproblem(*models, phase1);
     feasibility_phase_ = phase1;
@@ -749,18 +820,28 @@ void SaoRun::run(const std::vector<double>& x0) {
       ++stalled;
       continue;
     }
+    const std::size_t known_before = known_.size();
     const auto cand = evaluate(from_s(s));
     if (!cand) return;
+    const bool repeated = known_.size() == known_before;  // a known point: the models learn nothing
     const double phi_c = merit(known_[centre_]);
     const double phi_x = merit(known_[*cand]);
     const double actual = phi_c - phi_x;
     const double rho = actual / predicted;
     const bool on_boundary = step >= 1 - 1e-3;
     const double old_radius = radius_;
+    // Noise: a prediction within the merit's noise level cannot be checked by one evaluation, and
+    // a smaller region only makes the predicted reductions smaller still. Such a failed step
+    // keeps the radius (the candidate joins the fit: more points average the noise), and an
+    // accepted step whose shortfall is within the noise counts as a success.
+    const double sigma = sao_.noise_tolerance * merit_noise(*models, phase1);
+    const bool within_noise = predicted <= sigma && !repeated;
     if (!(actual > 0)) {
-      radius_ *= sao_.shrink_factor;  // rejected: keep the centre
+      if (!within_noise) radius_ *= sao_.shrink_factor;  // rejected: keep the centre
     } else {
-      if (rho <= sao_.rho_shrink) radius_ *= sao_.shrink_factor;
+      if (rho <= sao_.rho_shrink) {
+        if (predicted - actual > sigma) radius_ *= sao_.shrink_factor;
+      }
       else if (rho >= sao_.rho_expand_low && rho <= sao_.rho_expand_high && on_boundary)
         radius_ = std::min(sao_.max_radius, radius_ * sao_.expand_factor);
       else if (step < sao_.short_step) radius_ *= sao_.shrink_factor;
@@ -768,9 +849,11 @@ void SaoRun::run(const std::vector<double>& x0) {
       centre_z_ = known_[centre_].z;
     }
     if (std::getenv("ABUOPT_SAO_TRACE"))
-      std::fprintf(stderr, "it %ld evals %ld basis %s [%s] phase1 %d r %.3g->%.3g rho %.3g pred %.3g act %.3g mu %.3g step %.3f fc %.8g\n",
-                   iterations, driver_.evaluations(), models->basis.c_str(), models->forms.c_str(), phase1 ? 1 : 0, old_radius, radius_, rho,
-                   predicted, actual, mu_, step, known_[centre_].f);
+      std::fprintf(stderr, "it %ld evals %ld basis %s [%s] phase1 %d r %.3g->%.3g rho %.3g pred %.3g act %.3g sigma %.3g "
+                   "(f %.2g) mu %.3g step %.3f fc %.8g\n",
+                   iterations, driver_.evaluations(), models->basis.c_str(), models->forms.c_str(), phase1 ? 1 : 0, old_radius,
+                   radius_, rho, predicted, actual, sigma, models->noise.empty() ? 0.0 : models->noise_fraction[0], mu_, step,
+                   known_[centre_].f);
     const bool progress = actual > sao_.stall_tolerance * std::max(1.0, std::fabs(phi_c));
     stalled = progress ? 0 : stalled + 1;
   }

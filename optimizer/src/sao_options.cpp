@@ -83,6 +83,8 @@ void SaoOptions::validate(const std::string& p) const {
           rho_expand_high, "must be >= rho_expand_low = " + format_number(rho_expand_low));
   require(std::isfinite(short_step) && short_step >= 0 && short_step < 1, p, "short_step", short_step,
           "must be in [0, 1) (0: off)");
+  require(std::isfinite(noise_tolerance) && noise_tolerance >= 0 && noise_tolerance <= 100, p, "noise_tolerance",
+          noise_tolerance, "must be in [0, 100] (0: off)");
   require(std::isfinite(penalty_initial) && penalty_initial >= 0, p, "penalty_initial", penalty_initial,
           "must be >= 0 (0: automatic)");
   require(std::isfinite(penalty_multiplier_factor) && penalty_multiplier_factor >= 1, p, "penalty_multiplier_factor",
@@ -123,6 +125,7 @@ SaoOptions read_sao_options(YamlReader& r) {
   if (o.intervening_constraints == o.intervening) o.intervening_constraints.clear();
   o.correction = r.get_bool_or("correction", o.correction);
   o.short_step = r.get_double_or("short_step", o.short_step);
+  o.noise_tolerance = r.get_double_or("noise_tolerance", o.noise_tolerance);
   o.penalty_initial = r.get_double_or("penalty_initial", o.penalty_initial);
   o.penalty_multiplier_factor = r.get_double_or("penalty_multiplier_factor", o.penalty_multiplier_factor);
   o.stall_iterations = static_cast<int>(r.get_int_or("stall_iterations", o.stall_iterations, Rule::in_range(1, 1e6)));

@@ -78,6 +78,13 @@ struct SaoOptions {
   // (without it a biased model creeps in ever smaller steps with rho ~ 1). 0: off. In [0, 1).
   double short_step = 0.1;
 
+  // Noise tolerance of the ratio test (kappa): the merit's noise level sigma is estimated from the
+  // residuals of the least-squares surrogates (docs/sao.md); a step whose predicted reduction is
+  // at most kappa * sigma does not shrink the region when it fails, and an accepted step whose
+  // shortfall (predicted - actual) is at most kappa * sigma does not either. 0: off (the classical
+  // ratio test). In [0, 100].
+  double noise_tolerance = 1.0;
+
   // Initial exact-penalty weight mu; 0: automatic, 10 max(1, |f(x0)|).
   double penalty_initial = 0.0;
   // mu >= penalty_multiplier_factor * max |lambda| (estimated multipliers); >= 1.
