@@ -83,6 +83,10 @@ struct Models {
   // The same residual RMS relative to the responses' weighted standard deviation on the fit zone
   // (1: the model explains nothing; ~0: smooth at this scale).
   std::vector<double> noise_fraction;
+  // Back-off of every inequality in the sub-problem (g^ + margin <= 0): kappa times its confirmed
+  // noise level, so that a candidate aims inside the noisy band of the bound instead of on it
+  // (set by solve_subproblem; 0 without confirmed noise).
+  std::vector<double> g_margin;
 
   std::size_t n_g() const { return gm.size(); }
   std::size_t n_h() const { return hm.size(); }
@@ -148,7 +152,8 @@ void sub_constraints(unsigned m, double* result, unsigned n, const double* s, do
   const SubContext& c = *static_cast<SubContext*>(data);
   const Eigen::VectorXd xs = Eigen::Map<const Eigen::VectorXd>(s, n);
   for (unsigned i = 0; i < m; ++i) {
-    result[i] = Equality ? c.models->h(i, xs) : c.models->g(i, xs);
+    result[i] = Equality ? c.models->h(i, xs)
+                         : c.models->g(i, xs) + (i < c.models->g_margin.size() ? c.models->g_margin[i] : 0.0);
     if (grad) {
       const Eigen::VectorXd gr = Equality ? c.models->h_grad(i, xs) : c.models->g_grad(i, xs);
       std::copy(gr.data(), gr.data() + n, grad + static_cast<std::size_t>(i) * n);
@@ -216,7 +221,7 @@ class SaoRun {
   bool minimal_design() const;
   bool repair_geometry();  // false: stopped
   std::optional<Models> fit(const std::string& basis);
-  Eigen::VectorXd solve_subproblem(const Models& models, bool& feasibility_phase);
+  Eigen::VectorXd solve_subproblem(Models& models, bool& feasibility_phase);
   Eigen::VectorXd run_nlopt(const Models& models, bool feasibility_phase, const Eigen::VectorXd& start,
                             const Eigen::VectorXd& lo, const Eigen::VectorXd& hi) const;
   void update_penalty(const Models& models, const Eigen::VectorXd& s);
@@ -552,11 +557,13 @@ std::optional<Models> SaoRun::fit(const std::string& requested) {
         }
         const InterveningChoice* previous = last_choice_[k].exponents.size() == n_ ? &last_choice_[k] : nullptr;
         InterveningChoice c = fit_intervening(form_of(k), surrogate::basis_from_string(basis), data, y, previous);
+        // the noise probe: the residuals of this fit (none when it interpolates, m <= p)
         const int p = surrogate::terms_count(surrogate::basis_from_string(basis), n_);
+        const surrogate::Surrogate* probe = c.model.get();
         if (m > p) {
           double wsum = 0, sse = 0, mean = 0;
           for (int i = 0; i < m; ++i) {
-            const double e = y[i] - c.model->value(data.S.row(i).transpose());
+            const double e = y[i] - probe->value(data.S.row(i).transpose());
             sse += w[i] * e * e;
             wsum += w[i];
             mean += w[i] * y[i];
@@ -642,7 +649,7 @@ Eigen::VectorXd SaoRun::run_nlopt(const Models& models, bool feasibility_phase, 
   return out.cwiseMax(lo).cwiseMin(hi);
 }
 
-Eigen::VectorXd SaoRun::solve_subproblem(const Models& models, bool& feasibility_phase) {
+Eigen::VectorXd SaoRun::solve_subproblem(Models& models, bool& feasibility_phase) {
   Eigen::VectorXd lo(n_), hi(n_);
   for (int i = 0; i < n_; ++i) {
     lo[i] = (std::max(0.0, centre_z_[i] - radius_) - centre_z_[i]) / radius_;
@@ -663,15 +670,30 @@ Eigen::VectorXd SaoRun::solve_subproblem(const Models& models, bool& feasibility
   const double tol = options_.constraint_tolerance;
   std::optional<Eigen::VectorXd> best_s;
   double best_f = kInf;
-  for (const auto& st : starts) {
-    const Eigen::VectorXd s = run_nlopt(models, false, st, lo, hi);
-    if (models.max_violation(s) > std::max(tol, 1e-12)) continue;
-    const double f = models.f(s);
-    if (f < best_f) {
-      best_f = f;
-      best_s = s;
+  // with confirmed constraint noise first with the constraints backed off by it, then (nothing
+  // feasible so) without
+  std::vector<double> margin(m_ineq_, 0.0);
+  bool backed_off = false;
+  for (std::size_t i = 0; i < m_ineq_ && i + 1 < models.noise.size(); ++i) {
+    margin[i] = sao_.noise_tolerance * models.noise[1 + i];
+    backed_off = backed_off || margin[i] > 0;
+  }
+  for (int attempt = backed_off ? 0 : 1; attempt < 2 && !best_s; ++attempt) {
+    models.g_margin = attempt == 0 ? margin : std::vector<double>(m_ineq_, 0.0);
+    for (const auto& st : starts) {
+      const Eigen::VectorXd s = run_nlopt(models, false, st, lo, hi);
+      double v = 0;
+      for (std::size_t i = 0; i < m_ineq_; ++i) v = std::max(v, models.g(i, s) + models.g_margin[i]);
+      for (std::size_t j = 0; j < m_eq_; ++j) v = std::max(v, std::fabs(models.h(j, s)));
+      if (v > std::max(tol, 1e-12)) continue;
+      const double f = models.f(s);
+      if (f < best_f) {
+        best_f = f;
+        best_s = s;
+      }
     }
   }
+  models.g_margin.assign(m_ineq_, 0.0);
   if (best_s) {
     feasibility_phase = false;
     return *best_s;
@@ -835,7 +857,10 @@ void SaoRun::run(const std::vector<double>& x0) {
     // keeps the radius (the candidate joins the fit: more points average the noise), and an
     // accepted step whose shortfall is within the noise counts as a success.
     const double sigma = sao_.noise_tolerance * merit_noise(*models, phase1);
-    const bool within_noise = predicted <= sigma && !repeated;
+    // a new design whose merit is exactly the centre's: the response is flat (quantised,
+    // piecewise constant) at this scale, and a smaller region would only see more of the same
+    const bool flat = actual == 0 && !repeated;
+    const bool within_noise = (predicted <= sigma || flat) && !repeated;
     if (!(actual > 0)) {
       if (!within_noise) radius_ *= sao_.shrink_factor;  // rejected: keep the centre
     } else {

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <iostream>
 #include <string>
 
@@ -172,6 +173,37 @@ TEST(Sao, FailedEvaluationsAreSurvived) {
   EXPECT_NEAR(r.x[1], -0.2, 1e-3);
 }
 
+// A piecewise-constant, rippled bowl (a Monte Carlo estimate with common random numbers looks like
+// this): the noise-aware ratio test (noise_tolerance, default 1) must not do worse than the
+// classical one (0), which shrinks the region below the noise and stops early.
+TEST(Sao, NoiseAwareRatioTestOnPiecewiseConstantResponse) {
+  auto make = [] {
+    auto p = std::make_unique<opt::FunctionProblem>(
+        "quantised_bowl", std::vector<opt::Variable>{{"a", 0, 1, 1}, {"b", 0, 1, 1}, {"c", 0, 1, 1}},
+        [](const std::vector<double>& x) {
+          const double bowl = 4 * ((x[0] - 0.3) * (x[0] - 0.3) + (x[1] - 0.7) * (x[1] - 0.7) + (x[2] - 0.4) * (x[2] - 0.4));
+          const double ripple = 0.2 * std::sin(53 * x[0] + 1) * std::sin(47 * x[1] + 2) * std::sin(59 * x[2] + 3);
+          opt::Evaluation e;
+          e.objective = std::floor((bowl + ripple) * 16) / 16;  // quantised: steps of 1/16
+          return e;
+        });
+    p->set_initial_point({0.9, 0.1, 0.9});
+    return p;
+  };
+  opt::OptimizerOptions o;
+  o.max_evaluations = 60;
+  opt::SaoOptions classical;
+  classical.noise_tolerance = 0;
+  auto p1 = make();
+  auto p2 = make();
+  const opt::OptimizationResult with_noise = opt::minimize_sao(*p1, o, opt::SaoOptions{});
+  const opt::OptimizationResult without = opt::minimize_sao(*p2, o, classical);
+  std::cout << "[measure] quantised bowl: noise_tolerance 1: " << with_noise.brief_report()
+            << "; noise_tolerance 0: " << without.brief_report() << "\n";
+  ASSERT_TRUE(with_noise.has_feasible_point());
+  EXPECT_LE(with_noise.objective, without.objective);
+}
+
 // The points of an attached archive inform the surrogates and are not evaluated again.
 TEST(Sao, ReusesArchivedPoints) {
   auto problem = problems::make_benchmark("two_bar_truss");
@@ -266,6 +298,7 @@ TEST(SaoOptions, BadValuesNameKeyValueAndRule) {
             "sao.doe = koshal: koshal (n+1 points) cannot determine a quadratic surrogate; use auto, axial, "
             "central_composite or lhs");
   EXPECT_EQ(message([](auto& s) { s.reuse_distance = 0; }), "sao.reuse_distance = 0: must be in (0, 1]");
+  EXPECT_EQ(message([](auto& s) { s.noise_tolerance = -1; }), "sao.noise_tolerance = -1: must be in [0, 100] (0: off)");
 }
 
 TEST(SaoOptions, ReadFromYaml) {
@@ -279,6 +312,12 @@ TEST(SaoOptions, ReadFromYaml) {
   EXPECT_DOUBLE_EQ(s.max_radius, 0.8);
   EXPECT_FALSE(s.correction);
   EXPECT_DOUBLE_EQ(s.min_radius, opt::SaoOptions{}.min_radius);  // absent keys keep defaults
+  EXPECT_DOUBLE_EQ(s.noise_tolerance, 1.0);
+  {
+    YamlReader r2 = YamlReader::load_string("sao:\n  noise_tolerance: 0\n");
+    YamlReader sec2 = r2.child("sao");
+    EXPECT_DOUBLE_EQ(opt::read_sao_options(sec2).noise_tolerance, 0.0);
+  }
 
   auto error_of = [](const std::string& text) {
     return config_error_of([&] {
