@@ -4,8 +4,8 @@
 // config (exit status 2).
 #include <gtest/gtest.h>
 
-#include <array>
-#include <cstdio>
+#include "abuopt_cli.hpp"
+
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -16,20 +16,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int status;
-  std::string output;  // stdout + stderr
-};
+using Result = abuopt::test::CliResult;
 
 Result run(const std::string& args, bool with_stderr = true) {
-  const std::string cmd = std::string(ABUOPT_EXE) + " " + args + (with_stderr ? " 2>&1" : " 2>/dev/null");
-  std::array<char, 4096> buf{};
-  std::string out;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return {-1, ""};
-  while (fgets(buf.data(), buf.size(), p)) out += buf.data();
-  const int st = pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+  return abuopt::test::run_abuopt(args, "", with_stderr);
 }
 
 const std::string kQuick = std::string(ABUOPT_SOURCE_DIR) + "/configs/optimize/quick.yaml";

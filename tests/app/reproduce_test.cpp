@@ -3,31 +3,19 @@
 // per-case run CSVs, a run without gnuplot, and a bad table id.
 #include <gtest/gtest.h>
 
+#include "abuopt_cli.hpp"
+
 #include <sys/wait.h>
 
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
 namespace {
 
-struct Result {
-  int status;
-  std::string output;  // stdout + stderr
-};
+using Result = abuopt::test::CliResult;
 
-Result run(const std::string& args, const std::string& env = "") {
-  const std::string cmd = env + (env.empty() ? "" : " ") + std::string(ABUOPT_EXE) + " " + args + " 2>&1";
-  std::array<char, 4096> buf{};
-  std::string out;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return {-1, ""};
-  while (fgets(buf.data(), buf.size(), p)) out += buf.data();
-  const int st = pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
-}
+Result run(const std::string& args, const std::string& env = "") { return abuopt::test::run_abuopt(args, env); }
 
 std::string read_all(const std::string& path) {
   std::ifstream f(path);

@@ -2,31 +2,18 @@
 // input (exit status 2, key path + value + rule, never a stack trace).
 #include <gtest/gtest.h>
 
-#include <array>
-#include <cstdio>
+#include "abuopt_cli.hpp"
+
 #include <fstream>
-#include <memory>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
 namespace {
 
-struct Result {
-  int status;
-  std::string output;  // stdout + stderr
-};
+using Result = abuopt::test::CliResult;
 
-Result run(const std::string& args) {
-  const std::string cmd = std::string(ABUOPT_EXE) + " " + args + " 2>&1";
-  std::array<char, 4096> buf{};
-  std::string out;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return {-1, ""};
-  while (fgets(buf.data(), buf.size(), p)) out += buf.data();
-  const int st = pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
-}
+Result run(const std::string& args) { return abuopt::test::run_abuopt(args); }
 
 std::string write_config(const std::string& name, const std::string& text) {
   const std::string path = std::string(ABUOPT_BINARY_DIR) + "/" + name;
