@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include "expect_invalid_argument.hpp"
+
 namespace abuopt::surrogate {
 namespace {
 
@@ -23,16 +25,7 @@ bool inside_box(const Eigen::MatrixXd& design, double half_width = 1.0) {
   return design.cwiseAbs().maxCoeff() <= half_width + 1e-15;
 }
 
-// The message of the std::invalid_argument thrown by `f` ("" if none).
-template <class F>
-std::string invalid_argument_message(F f) {
-  try {
-    f();
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::invalid_argument_message;
 
 TEST(FullFactorial, SizeLevelsAndOrder) {
   const Eigen::MatrixXd d = full_factorial(3, 3);

@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include "expect_invalid_argument.hpp"
+
 #include "abuopt/surrogate/doe.hpp"
 
 namespace abuopt::surrogate {
@@ -32,15 +34,7 @@ Eigen::MatrixXd lhs_points(int n, int points, std::uint64_t seed) {
   return latin_hypercube(n, options);
 }
 
-template <class F>
-std::string invalid_argument_message(F f) {
-  try {
-    f();
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::invalid_argument_message;
 
 TEST(Kriging, HandComputedTwoPointModel) {
   // x = 0, 1; y = 0, 1; l = 1, no nugget: rho = exp(-1/2), mu = 1/2 by symmetry,

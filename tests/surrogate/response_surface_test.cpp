@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include "expect_invalid_argument.hpp"
+
 #include "abuopt/surrogate/doe.hpp"
 
 namespace abuopt::surrogate {
@@ -47,15 +49,7 @@ Eigen::VectorXd evaluate(Basis basis, const Eigen::VectorXd& beta, const Eigen::
   return y;
 }
 
-template <class F>
-std::string invalid_argument_message(F f) {
-  try {
-    f();
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::invalid_argument_message;
 
 TEST(TermsCount, MatchesFormulas) {
   EXPECT_EQ(terms_count(Basis::kLinear, 3), 4);
