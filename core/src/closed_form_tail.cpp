@@ -22,14 +22,16 @@ bool closed_form_tail(RunState& rs, double tbar, std::vector<double>& y, double 
   // Steady state from the forces with zero table velocity: solve the 2x2 static balance.
   double Cx = rs.nd.mbar_I * rs.nd.ebar, Cy = 0;
   for (std::size_t i = 0; i < rs.n; ++i) {
-    Cx += rs.nd.mbar[i] * std::cos(y[4 + i]);
-    Cy += rs.nd.mbar[i] * std::sin(y[4 + i]);
+    Cx += rs.nd.mbar[i] * std::cos(y[rs.lay().beta(i)]);
+    Cy += rs.nd.mbar[i] * std::sin(y[rs.lay().beta(i)]);
   }
   Cx *= W * W;
   Cy *= W * W;
   const double a11 = 1 - W * W, a12 = -2 * bb * W, a21 = 2 * bb * W, a22 = 1 - W * W;
   const double det = a11 * a22 - a12 * a21;
   Eigen::Vector4d zs((Cx * a22 - a12 * Cy) / det, (a11 * Cy - Cx * a21) / det, 0, 0);
+  // z is the table part of the state: StateLayout::x, y, x_dot, y_dot are its first four entries.
+  static_assert(StateLayout::x == 0 && StateLayout::y == 1 && StateLayout::x_dot == 2 && StateLayout::y_dot == 3);
   Eigen::Vector4d e0(y[0] - zs[0], y[1] - zs[1], y[2], y[3]);
 
   Eigen::EigenSolver<Eigen::Matrix4d> es(A);

@@ -17,10 +17,9 @@ Speed evaluate_forces(RunState& rs, double tbar, const double* y) {
     rs.model.evaluate(y, sp.W, sp.Wp, rs.modes.data(), rs.mu, rs.forces);
     return sp;
   }
-  // PI motor: states y[nabu] = delta = theta_ref - theta [rad], y[nabu+1] = W.
-  const std::size_t k = 4 + 2 * rs.n;
-  const double W = y[k + 1];
-  const double delta = y[k];
+  // PI motor: states delta = theta_ref - theta [rad] and W (StateLayout::motor_delta/motor_speed).
+  const double W = y[rs.lay().motor_speed()];
+  const double delta = y[rs.lay().motor_delta()];
   const double t = tbar / rs.omega_n;
   const double f_ref = rs.motor.realised_reference_hz(rs.profile->frequency_hz(t));
   const double Omega = W * rs.omega_n;
@@ -37,7 +36,7 @@ Speed evaluate_forces(RunState& rs, double tbar, const double* y) {
     for (int pass = 0; pass < 2; ++pass) {
       double torque = 0;  // reaction of the balls' friction (and viscous damping) on the disc
       for (std::size_t i = 0; i < rs.n; ++i)
-        torque += (rs.forces.fw[i] + rs.nd.cbar[i] * y[4 + rs.n + i]) * rs.params.balls[i].mass_kg * w2 * L * L;
+        torque += (rs.forces.fw[i] + rs.nd.cbar[i] * y[rs.lay().beta_dot(i)]) * rs.params.balls[i].mass_kg * w2 * L * L;
       Wp = (accel0 + torque / rs.motor.inertia_kgm2) / w2;
       rs.model.evaluate(y, W, Wp, rs.modes.data(), rs.mu, rs.forces);
     }
@@ -61,36 +60,36 @@ void rhs_plain(double tbar, const double* y, double* yd, void* user) {
   if (rs.frozen) {
     const Speed sp = ideal_speed(rs, tbar);
     const double W = sp.W, Wp = sp.Wp, W2 = W * W, bb = rs.nd.bbar;
-    const double x = y[0], yy = y[1], xd = y[2], ydd = y[3];
+    const double x = y[StateLayout::x], yy = y[StateLayout::y], xd = y[StateLayout::x_dot], ydd = y[StateLayout::y_dot];
     const double hx = -2.0 * ydd * W - x * W2 - rs.nd.mbar_I * rs.nd.ebar * W2 - Wp * (yy + rs.frozen_ss) -
                       W2 * rs.frozen_sc + x + 2.0 * bb * (xd - yy * W);
     const double hy = 2.0 * xd * W - yy * W2 + Wp * (x + rs.nd.mbar_I * rs.nd.ebar + rs.frozen_sc) -
                       W2 * rs.frozen_ss + yy + 2.0 * bb * (ydd + x * W);
-    yd[0] = xd;
-    yd[1] = ydd;
-    yd[2] = -hx;
-    yd[3] = -hy;
-    std::fill(yd + 4, yd + 4 + 2 * rs.n, 0.0);
+    yd[StateLayout::x] = xd;
+    yd[StateLayout::y] = ydd;
+    yd[StateLayout::x_dot] = -hx;
+    yd[StateLayout::y_dot] = -hy;
+    std::fill(yd + StateLayout::table_size, yd + rs.lay().size(), 0.0);
     return;
   }
   if (rs.opt.method == FrictionMethod::SwitchModel) switch_modes(rs, tbar, y);
   const Speed sp = evaluate_forces(rs, tbar, y);
   const std::size_t n = rs.n;
-  yd[0] = y[2];
-  yd[1] = y[3];
-  yd[2] = rs.forces.xdd;
-  yd[3] = rs.forces.ydd;
+  const StateLayout& lay = rs.lay();
+  yd[StateLayout::x] = y[StateLayout::x_dot];
+  yd[StateLayout::y] = y[StateLayout::y_dot];
+  yd[StateLayout::x_dot] = rs.forces.xdd;
+  yd[StateLayout::y_dot] = rs.forces.ydd;
   for (std::size_t i = 0; i < n; ++i) {
     const bool frozen = rs.modes[i] == BallMode::Stick;
-    yd[4 + i] = frozen ? 0.0 : y[4 + n + i];
-    yd[4 + n + i] = rs.forces.betadd[i];
+    yd[lay.beta(i)] = frozen ? 0.0 : y[lay.beta_dot(i)];
+    yd[lay.beta_dot(i)] = rs.forces.betadd[i];
   }
   if (rs.pi_motor) {
-    const std::size_t k = 4 + 2 * n;
     const double t = tbar / rs.omega_n;
     const double W_ref = kTwoPi * rs.motor.realised_reference_hz(rs.profile->frequency_hz(t)) / rs.omega_n;
-    yd[k] = (W_ref - y[k + 1]);  // d delta / dtbar = (Omega_ref - Omega)/omega_n
-    yd[k + 1] = sp.Wp;
+    yd[lay.motor_delta()] = (W_ref - y[lay.motor_speed()]);  // d delta / dtbar = (Omega_ref - Omega)/omega_n
+    yd[lay.motor_speed()] = sp.Wp;
   }
 }
 
@@ -105,7 +104,7 @@ void roots_plain(double tbar, const double* y, double* g, void* user) {
       g[2 * i] = lim - rs.forces.fw[i] + rs.off_a[i];
       g[2 * i + 1] = lim + rs.forces.fw[i] + rs.off_b[i];
     } else {
-      g[2 * i] = static_cast<double>(static_cast<signed char>(rs.modes[i])) * y[4 + rs.n + i];
+      g[2 * i] = static_cast<double>(static_cast<signed char>(rs.modes[i])) * y[rs.lay().beta_dot(i)];
       g[2 * i + 1] = 1.0;
     }
   }
@@ -128,7 +127,7 @@ void set_root_offsets(RunState& rs, double tbar, const double* y) {
 bool all_stuck(const RunState& rs, const double* y) {
   for (std::size_t i = 0; i < rs.n; ++i) {
     if (rs.modes[i] != BallMode::Stick) return false;
-    if (rs.opt.method == FrictionMethod::SwitchModel && std::fabs(y[4 + rs.n + i]) > rs.opt.switch_band) return false;
+    if (rs.opt.method == FrictionMethod::SwitchModel && std::fabs(y[rs.lay().beta_dot(i)]) > rs.opt.switch_band) return false;
   }
   return true;
 }

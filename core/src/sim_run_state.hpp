@@ -42,6 +42,8 @@ struct RunState {
   bool frozen = false;
   double frozen_sc = 0, frozen_ss = 0;
 
+  const StateLayout& lay() const { return model.layout(); }
+
   explicit RunState(const AbuParameters& p) : params(p), nd(NondimParameters::from(p)), model(nd) {}
 
   // Call whenever the modes change (event-driven only).
@@ -50,8 +52,8 @@ struct RunState {
     frozen_sc = frozen_ss = 0;
     for (std::size_t i = 0; i < n && frozen; ++i) {
       frozen = modes[i] == BallMode::Stick;
-      frozen_sc += nd.mbar[i] * std::cos(y[4 + i]);
-      frozen_ss += nd.mbar[i] * std::sin(y[4 + i]);
+      frozen_sc += nd.mbar[i] * std::cos(y[lay().beta(i)]);
+      frozen_ss += nd.mbar[i] * std::sin(y[lay().beta(i)]);
     }
   }
 };

@@ -87,13 +87,14 @@ RunOutcome Simulator::run(const std::vector<double>& beta0, const RunOverrides& 
   rs.forces.resize(rs.n);
   rs.off_a.assign(rs.n, 0);
   rs.off_b.assign(rs.n, 0);
-  const std::size_t nabu = 4 + 2 * rs.n;
+  const StateLayout& lay = rs.lay();
+  const std::size_t nabu = lay.size();
   const std::size_t nvar = nabu + (rs.pi_motor ? 2 : 0);
   const bool event_driven = rs.opt.method == FrictionMethod::EventDriven;
 
   std::vector<double> y(nvar, 0.0);
   // Angles relative to the imbalance; an imbalance at angle phi sees the balls at beta - phi.
-  for (std::size_t i = 0; i < rs.n; ++i) y[4 + i] = wrap_angle(beta0[i] - ov.imbalance_angle_rad);
+  for (std::size_t i = 0; i < rs.n; ++i) y[lay.beta(i)] = wrap_angle(beta0[i] - ov.imbalance_angle_rad);
 
   const double w = rs.omega_n;
   const double t_end = end_time_s() * w;
@@ -112,7 +113,7 @@ RunOutcome Simulator::run(const std::vector<double>& beta0, const RunOverrides& 
     if (rs.pi_motor) {
       // the reference has moved a little; the disc has not
       const double fr = rs.motor.realised_reference_hz(setup_.profile.frequency_hz(tiny / w));
-      yprobe[nabu] = 0.25 * kTwoPi * fr / w * tiny;  // delta ~ integral of the reference speed
+      yprobe[lay.motor_delta()] = 0.25 * kTwoPi * fr / w * tiny;  // delta ~ integral of the reference speed
     }
     Speed sp = rs.pi_motor ? Speed{0, 0} : ideal_speed(rs, tiny);
     if (rs.pi_motor) {
@@ -147,11 +148,11 @@ RunOutcome Simulator::run(const std::vector<double>& beta0, const RunOverrides& 
   auto record = [&](double tt, const std::vector<double>& yy) {
     TrajectoryPoint tp;
     tp.t_s = tt / w;
-    tp.frequency_hz = rs.pi_motor ? yy[nabu + 1] * w / kTwoPi : setup_.profile.frequency_hz(tp.t_s);
-    tp.x_m = yy[0] * p.ball_track_radius_m;
-    tp.y_m = yy[1] * p.ball_track_radius_m;
+    tp.frequency_hz = rs.pi_motor ? yy[lay.motor_speed()] * w / kTwoPi : setup_.profile.frequency_hz(tp.t_s);
+    tp.x_m = yy[StateLayout::x] * p.ball_track_radius_m;
+    tp.y_m = yy[StateLayout::y] * p.ball_track_radius_m;
     for (std::size_t i = 0; i < rs.n; ++i) {
-      tp.beta.push_back(wrap_angle(yy[4 + i]));
+      tp.beta.push_back(wrap_angle(yy[lay.beta(i)]));
       tp.mode.push_back(static_cast<int>(static_cast<signed char>(rs.modes[i])));
     }
     trajectory->push_back(std::move(tp));
@@ -175,7 +176,7 @@ RunOutcome Simulator::run(const std::vector<double>& beta0, const RunOverrides& 
         next_traj += traj_dt;
       }
     }
-    peak_amp = std::max(peak_amp, std::hypot(y[0], y[1]) * L_mm);
+    peak_amp = std::max(peak_amp, std::hypot(y[StateLayout::x], y[StateLayout::y]) * L_mm);
 
     if (!event_driven) {
       // switch model: track the all-stuck period at step ends
@@ -196,9 +197,9 @@ RunOutcome Simulator::run(const std::vector<double>& beta0, const RunOverrides& 
       for (std::size_t i = 0; i < rs.n; ++i) {
         fixed[i] = 0;
         if (rs.modes[i] != BallMode::Stick) {
-          if (rinfo[2 * i] != 0) y[4 + rs.n + i] = 0.0;
+          if (rinfo[2 * i] != 0) y[lay.beta_dot(i)] = 0.0;
         } else {
-          y[4 + rs.n + i] = 0.0;
+          y[lay.beta_dot(i)] = 0.0;
           if (rinfo[2 * i] != 0 || rinfo[2 * i + 1] != 0) {
             fixed[i] = 1;
             rs.modes[i] = rs.forces.fw[i] > 0 ? BallMode::SlipForward : BallMode::SlipBackward;
@@ -252,7 +253,7 @@ RunOutcome Simulator::run(const std::vector<double>& beta0, const RunOverrides& 
   out.steps = integ.steps();
   out.rhs_evaluations = rs.rhs_evals;
   out.max_amplitude_mm = peak_amp;
-  for (std::size_t i = 0; i < rs.n; ++i) out.beta_final.push_back(wrap_angle(y[4 + i]));
+  for (std::size_t i = 0; i < rs.n; ++i) out.beta_final.push_back(wrap_angle(y[lay.beta(i)]));
   double ix = 0, iy = 0;
   AbuModel::imbalance_vector(p, out.beta_final.data(), ix, iy);
   out.residual_imbalance_kgm = std::hypot(ix, iy);
