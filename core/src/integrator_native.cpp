@@ -30,7 +30,9 @@ class NativeIntegrator final : public Integrator {
   void dense(double t, std::vector<double>& out) override { st_.dense(t, out.data()); }
   long steps() const override { return st_.steps(); }
   std::string failure() const override {
-    return last_ == ErkStepper::TooManySteps ? "step limit reached" : "step size became too small";
+    if (last_ == ErkStepper::TooManySteps) return "step limit reached";
+    if (last_ == ErkStepper::NotFinite) return "state or step size not finite";
+    return "step size became too small";
   }
   bool too_much_work() const override { return last_ == ErkStepper::TooManySteps; }
 
