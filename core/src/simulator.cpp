@@ -65,201 +65,253 @@ double Simulator::end_time_s() const {
   return setup_.options.end_time_s > 0 ? setup_.options.end_time_s : 2.0 * setup_.profile.duration_s();
 }
 
-RunOutcome Simulator::run(const std::vector<double>& beta0, const RunOverrides& ov,
-                          std::vector<TrajectoryPoint>* trajectory) const {
-  const auto wall0 = std::chrono::steady_clock::now();
-  if (beta0.size() != setup_.abu.balls.size())
-    throw ConfigError("the ABU has " + std::to_string(setup_.abu.balls.size()) + " balls, but " +
-                      std::to_string(beta0.size()) + " initial angles were given");
-  AbuParameters p = setup_.abu;
-  if (ov.friction_mu) p.friction_mu = *ov.friction_mu;
-  if (ov.imbalance_mass_kg) p.imbalance_mass_kg = *ov.imbalance_mass_kg;
+namespace {
 
-  RunState rs(p);
-  rs.profile = &setup_.profile;
-  rs.motor = setup_.motor;
-  rs.opt = setup_.options;
-  rs.mu = p.friction_mu;
-  rs.omega_n = rs.nd.omega_n;
-  rs.n = p.balls.size();
-  rs.pi_motor = setup_.motor.kind == MotorKind::PI;
-  rs.modes.assign(rs.n, BallMode::Stick);
-  rs.forces.resize(rs.n);
-  rs.off_a.assign(rs.n, 0);
-  rs.off_b.assign(rs.n, 0);
-  const StateLayout& lay = rs.lay();
-  const std::size_t nabu = lay.size();
-  const std::size_t nvar = nabu + (rs.pi_motor ? 2 : 0);
-  const bool event_driven = rs.opt.method == FrictionMethod::EventDriven;
+// One run from its initial angles to the end time, in three phases: mode initialisation (the
+// constructor), stepping with event handling (execute, handle_event), finishing (finish).
+class Run {
+ public:
+  Run(const SimulationSetup& setup, double end_time_s, const std::vector<double>& beta0, const RunOverrides& ov,
+      std::vector<TrajectoryPoint>* trajectory)
+      : setup_(setup), p_(with_overrides(setup.abu, ov)), rs_(p_), lay_(rs_.lay()), trajectory_(trajectory) {
+    rs_.profile = &setup_.profile;
+    rs_.motor = setup_.motor;
+    rs_.opt = setup_.options;
+    rs_.mu = p_.friction_mu;
+    rs_.omega_n = rs_.nd.omega_n;
+    rs_.n = p_.balls.size();
+    rs_.pi_motor = setup_.motor.kind == MotorKind::PI;
+    rs_.modes.assign(rs_.n, BallMode::Stick);
+    rs_.forces.resize(rs_.n);
+    rs_.off_a.assign(rs_.n, 0);
+    rs_.off_b.assign(rs_.n, 0);
+    nvar_ = lay_.size() + (rs_.pi_motor ? 2 : 0);
+    event_driven_ = rs_.opt.method == FrictionMethod::EventDriven;
+    w_ = rs_.omega_n;
+    t_end_ = end_time_s * w_;
+    t_profile_ = setup_.profile.duration_s() * w_;
+    out_.end_time_s = end_time_s;
+    L_mm_ = p_.ball_track_radius_m * 1e3;
+    traj_dt_ = rs_.opt.trajectory_interval_s * w_;
 
-  std::vector<double> y(nvar, 0.0);
-  // Angles relative to the imbalance; an imbalance at angle phi sees the balls at beta - phi.
-  for (std::size_t i = 0; i < rs.n; ++i) y[lay.beta(i)] = wrap_angle(beta0[i] - ov.imbalance_angle_rad);
-
-  const double w = rs.omega_n;
-  const double t_end = end_time_s() * w;
-  const double t_profile = setup_.profile.duration_s() * w;
-  RunOutcome out;
-  out.end_time_s = end_time_s();
-  double peak_amp = 0;
-  const double L_mm = p.ball_track_radius_m * 1e3;
-
-  // Initial modes from what happens just after t = 0: at rest every force is zero, so decide at
-  // a tiny time with the rest state (forces then scale alike and the relative test works).
-  {
-    const double first = setup_.profile.segments().empty() ? 1.0 : setup_.profile.segments()[0].duration_s;
-    const double tiny = 1e-6 * first * w;
-    std::vector<double> yprobe(y);
-    if (rs.pi_motor) {
-      // the reference has moved a little; the disc has not
-      const double fr = rs.motor.realised_reference_hz(setup_.profile.frequency_hz(tiny / w));
-      yprobe[lay.motor_delta()] = 0.25 * kTwoPi * fr / w * tiny;  // delta ~ integral of the reference speed
-    }
-    Speed sp = rs.pi_motor ? Speed{0, 0} : ideal_speed(rs, tiny);
-    if (rs.pi_motor) {
-      rs.modes.assign(rs.n, BallMode::Stick);
-      sp.Wp = evaluate_forces(rs, tiny, yprobe.data()).Wp;
-    }
-    rs.model.choose_modes(yprobe.data(), sp.W, sp.Wp, rs.mu, 0.0, rs.modes.data(), rs.forces);
-    rs.modes_changed(y.data());
+    y_.assign(nvar_, 0.0);
+    // Angles relative to the imbalance; an imbalance at angle phi sees the balls at beta - phi.
+    for (std::size_t i = 0; i < rs_.n; ++i) y_[lay_.beta(i)] = wrap_angle(beta0[i] - ov.imbalance_angle_rad);
+    choose_initial_modes();
   }
 
-  std::unique_ptr<Integrator> integ_ptr = make_integrator(rs, nvar, event_driven);
+  RunOutcome execute();
+
+ private:
+  static AbuParameters with_overrides(AbuParameters p, const RunOverrides& ov) {
+    if (ov.friction_mu) p.friction_mu = *ov.friction_mu;
+    if (ov.imbalance_mass_kg) p.imbalance_mass_kg = *ov.imbalance_mass_kg;
+    return p;
+  }
+  void choose_initial_modes();
+  bool handle_event(double t);  // false: a guard ended the run (status set)
+  void track_all_stuck(double t) {
+    if (all_stuck(rs_, y_.data())) {
+      if (all_stuck_since_ < 0) all_stuck_since_ = t;
+    } else {
+      all_stuck_since_ = -1;
+    }
+  }
+  void record(double tt, const std::vector<double>& yy);
+  RunOutcome finish(const Integrator& integ);
+
+  const SimulationSetup& setup_;
+  AbuParameters p_;  // with the run's overrides applied
+  RunState rs_;
+  const StateLayout& lay_;
+  std::vector<TrajectoryPoint>* trajectory_;
+  std::size_t nvar_ = 0;
+  bool event_driven_ = true;
+  double w_ = 0, t_end_ = 0, t_profile_ = 0, L_mm_ = 0, traj_dt_ = 0;
+  std::vector<double> y_;
+  RunOutcome out_;
+  double peak_amp_ = 0;
+  double all_stuck_since_ = -1;
+  std::vector<int> rinfo_;
+  std::vector<char> fixed_;
+  std::deque<double> recent_events_;
+};
+
+// Initial modes from what happens just after t = 0: at rest every force is zero, so decide at a
+// tiny time with the rest state (forces then scale alike and the relative test works).
+void Run::choose_initial_modes() {
+  const double w = w_;
+  const double first = setup_.profile.segments().empty() ? 1.0 : setup_.profile.segments()[0].duration_s;
+  const double tiny = 1e-6 * first * w;
+  std::vector<double> yprobe(y_);
+  if (rs_.pi_motor) {
+    // the reference has moved a little; the disc has not
+    const double fr = rs_.motor.realised_reference_hz(setup_.profile.frequency_hz(tiny / w));
+    yprobe[lay_.motor_delta()] = 0.25 * kTwoPi * fr / w * tiny;  // delta ~ integral of the reference speed
+  }
+  Speed sp = rs_.pi_motor ? Speed{0, 0} : ideal_speed(rs_, tiny);
+  if (rs_.pi_motor) {
+    rs_.modes.assign(rs_.n, BallMode::Stick);
+    sp.Wp = evaluate_forces(rs_, tiny, yprobe.data()).Wp;
+  }
+  rs_.model.choose_modes(yprobe.data(), sp.W, sp.Wp, rs_.mu, 0.0, rs_.modes.data(), rs_.forces);
+  rs_.modes_changed(y_.data());
+}
+
+void Run::record(double tt, const std::vector<double>& yy) {
+  TrajectoryPoint tp;
+  tp.t_s = tt / w_;
+  tp.frequency_hz = rs_.pi_motor ? yy[lay_.motor_speed()] * w_ / kTwoPi : setup_.profile.frequency_hz(tp.t_s);
+  tp.x_m = yy[StateLayout::x] * p_.ball_track_radius_m;
+  tp.y_m = yy[StateLayout::y] * p_.ball_track_radius_m;
+  for (std::size_t i = 0; i < rs_.n; ++i) {
+    tp.beta.push_back(wrap_angle(yy[lay_.beta(i)]));
+    tp.mode.push_back(static_cast<int>(static_cast<signed char>(rs_.modes[i])));
+  }
+  trajectory_->push_back(std::move(tp));
+}
+
+// A root of the stick/slip functions at t: re-choose the modes, count the event, apply the guards.
+bool Run::handle_event(double t) {
+  // A slipping ball whose speed reached zero may stick or reverse: a candidate. A stuck ball
+  // whose friction margin reached zero leaves stick in the direction of the force needed to
+  // hold it (the net force); the others are re-chosen consistently with that.
+  std::vector<double>& y = y_;
+  const Speed sp0 = evaluate_forces(rs_, t, y.data());
+  for (std::size_t i = 0; i < rs_.n; ++i) {
+    fixed_[i] = 0;
+    if (rs_.modes[i] != BallMode::Stick) {
+      if (rinfo_[2 * i] != 0) y[lay_.beta_dot(i)] = 0.0;
+    } else {
+      y[lay_.beta_dot(i)] = 0.0;
+      if (rinfo_[2 * i] != 0 || rinfo_[2 * i + 1] != 0) {
+        fixed_[i] = 1;
+        rs_.modes[i] = rs_.forces.fw[i] > 0 ? BallMode::SlipForward : BallMode::SlipBackward;
+      }
+    }
+  }
+  const Speed sp = rs_.pi_motor ? sp0 : ideal_speed(rs_, t);
+  rs_.model.choose_modes(y.data(), sp.W, sp.Wp, rs_.mu, 0.0, rs_.modes.data(), rs_.forces, &fixed_);
+  rs_.modes_changed(y.data());
+  ++out_.events;
+  recent_events_.push_back(t);
+  while (!recent_events_.empty() && (t - recent_events_.front()) > rs_.opt.chatter_window_s * w_)
+    recent_events_.pop_front();
+  if (static_cast<long>(recent_events_.size()) > rs_.opt.chatter_events) {
+    out_.status = RunStatus::ChatterLimit;
+    out_.message = "more than " + std::to_string(rs_.opt.chatter_events) + " stick/slip events within " +
+                   std::to_string(rs_.opt.chatter_window_s) + " s at t = " + std::to_string(t / w_) + " s";
+    return false;
+  }
+  if (out_.events > rs_.opt.max_events) {
+    out_.status = RunStatus::ChatterLimit;
+    out_.message = "more than " + std::to_string(rs_.opt.max_events) + " stick/slip events";
+    return false;
+  }
+  track_all_stuck(t);
+  return true;
+}
+
+RunOutcome Run::execute() {
+  std::unique_ptr<Integrator> integ_ptr = make_integrator(rs_, nvar_, event_driven_);
   Integrator& integ = *integ_ptr;
+  std::vector<double>& y = y_;
   double t = 0;
   integ.reset(t, y);
-  if (event_driven) set_root_offsets(rs, t, y.data());
+  if (event_driven_) set_root_offsets(rs_, t, y.data());
 
   std::vector<double> breaks;
   for (double b : setup_.profile.breakpoints_s())
-    if (b * w > 0 && b * w < t_end) breaks.push_back(b * w);
-  breaks.push_back(t_end);
+    if (b * w_ > 0 && b * w_ < t_end_) breaks.push_back(b * w_);
+  breaks.push_back(t_end_);
   std::size_t next_break = 0;
   integ.set_stop(breaks[0]);
 
-  std::vector<int> rinfo(2 * rs.n);
-  std::vector<char> fixed(rs.n, 0);
-  std::deque<double> recent_events;
-  double all_stuck_since = all_stuck(rs, y.data()) ? 0.0 : -1.0;
-  double next_tail_check = t_profile;
+  rinfo_.assign(2 * rs_.n, 0);
+  fixed_.assign(rs_.n, 0);
+  all_stuck_since_ = all_stuck(rs_, y.data()) ? 0.0 : -1.0;
+  double next_tail_check = t_profile_;
   double next_traj = 0;
-  const double traj_dt = rs.opt.trajectory_interval_s * w;
-  std::vector<double> ytraj(nvar);
-  auto record = [&](double tt, const std::vector<double>& yy) {
-    TrajectoryPoint tp;
-    tp.t_s = tt / w;
-    tp.frequency_hz = rs.pi_motor ? yy[lay.motor_speed()] * w / kTwoPi : setup_.profile.frequency_hz(tp.t_s);
-    tp.x_m = yy[StateLayout::x] * p.ball_track_radius_m;
-    tp.y_m = yy[StateLayout::y] * p.ball_track_radius_m;
-    for (std::size_t i = 0; i < rs.n; ++i) {
-      tp.beta.push_back(wrap_angle(yy[lay.beta(i)]));
-      tp.mode.push_back(static_cast<int>(static_cast<signed char>(rs.modes[i])));
-    }
-    trajectory->push_back(std::move(tp));
-  };
-  if (trajectory && traj_dt > 0) {
+  const bool tracing = trajectory_ && traj_dt_ > 0;
+  std::vector<double> ytraj(nvar_);
+  if (tracing) {
     record(0, y);
-    next_traj = traj_dt;
+    next_traj = traj_dt_;
   }
 
-  while (t < t_end) {
-    const Integrator::Result res = integ.step(t, y, rinfo);
+  while (t < t_end_) {
+    const Integrator::Result res = integ.step(t, y, rinfo_);
     if (res == Integrator::Failure) {
-      out.status = integ.too_much_work() ? RunStatus::StepLimit : RunStatus::SolverFailure;
-      out.message = integ.failure() + " at t = " + std::to_string(t / w) + " s";
+      out_.status = integ.too_much_work() ? RunStatus::StepLimit : RunStatus::SolverFailure;
+      out_.message = integ.failure() + " at t = " + std::to_string(t / w_) + " s";
       break;
     }
-    if (trajectory && traj_dt > 0) {
-      while (next_traj <= t && next_traj <= t_end) {
+    if (tracing) {
+      while (next_traj <= t && next_traj <= t_end_) {
         integ.dense(next_traj, ytraj);
         record(next_traj, ytraj);
-        next_traj += traj_dt;
+        next_traj += traj_dt_;
       }
     }
-    peak_amp = std::max(peak_amp, std::hypot(y[StateLayout::x], y[StateLayout::y]) * L_mm);
+    peak_amp_ = std::max(peak_amp_, std::hypot(y[StateLayout::x], y[StateLayout::y]) * L_mm_);
 
-    if (!event_driven) {
+    if (!event_driven_) {
       // switch model: track the all-stuck period at step ends
-      switch_modes(rs, t, y.data());
-      if (all_stuck(rs, y.data())) {
-        if (all_stuck_since < 0) all_stuck_since = t;
-      } else {
-        all_stuck_since = -1;
-      }
+      switch_modes(rs_, t, y.data());
+      track_all_stuck(t);
     }
 
     bool reset_needed = false;
     if (res == Integrator::Root) {
-      // A slipping ball whose speed reached zero may stick or reverse: a candidate. A stuck ball
-      // whose friction margin reached zero leaves stick in the direction of the force needed to
-      // hold it (the net force); the others are re-chosen consistently with that.
-      const Speed sp0 = evaluate_forces(rs, t, y.data());
-      for (std::size_t i = 0; i < rs.n; ++i) {
-        fixed[i] = 0;
-        if (rs.modes[i] != BallMode::Stick) {
-          if (rinfo[2 * i] != 0) y[lay.beta_dot(i)] = 0.0;
-        } else {
-          y[lay.beta_dot(i)] = 0.0;
-          if (rinfo[2 * i] != 0 || rinfo[2 * i + 1] != 0) {
-            fixed[i] = 1;
-            rs.modes[i] = rs.forces.fw[i] > 0 ? BallMode::SlipForward : BallMode::SlipBackward;
-          }
-        }
-      }
-      const Speed sp = rs.pi_motor ? sp0 : ideal_speed(rs, t);
-      rs.model.choose_modes(y.data(), sp.W, sp.Wp, rs.mu, 0.0, rs.modes.data(), rs.forces, &fixed);
-      rs.modes_changed(y.data());
-      ++out.events;
-      recent_events.push_back(t);
-      while (!recent_events.empty() && (t - recent_events.front()) > rs.opt.chatter_window_s * w) recent_events.pop_front();
-      if (static_cast<long>(recent_events.size()) > rs.opt.chatter_events) {
-        out.status = RunStatus::ChatterLimit;
-        out.message = "more than " + std::to_string(rs.opt.chatter_events) + " stick/slip events within " +
-                      std::to_string(rs.opt.chatter_window_s) + " s at t = " + std::to_string(t / w) + " s";
-        break;
-      }
-      if (out.events > rs.opt.max_events) {
-        out.status = RunStatus::ChatterLimit;
-        out.message = "more than " + std::to_string(rs.opt.max_events) + " stick/slip events";
-        break;
-      }
-      if (all_stuck(rs, y.data())) {
-        if (all_stuck_since < 0) all_stuck_since = t;
-      } else {
-        all_stuck_since = -1;
-      }
+      if (!handle_event(t)) break;
       reset_needed = true;
     }
     if (next_break < breaks.size() && t >= breaks[next_break]) {
       ++next_break;
       if (next_break < breaks.size()) integ.set_stop(breaks[next_break]);
     }
-    if (t >= t_end) break;
+    if (t >= t_end_) break;
 
-    if (event_driven && rs.opt.closed_form_tail && !rs.pi_motor && !(trajectory && traj_dt > 0) && t >= t_profile && t >= next_tail_check &&
-        all_stuck_since >= 0) {
-      if (closed_form_tail(rs, t, y, t_end, peak_amp)) {
-        t = t_end;
+    if (event_driven_ && rs_.opt.closed_form_tail && !rs_.pi_motor && !tracing && t >= t_profile_ &&
+        t >= next_tail_check && all_stuck_since_ >= 0) {
+      if (closed_form_tail(rs_, t, y, t_end_, peak_amp_)) {
+        t = t_end_;
         break;
       }
-      next_tail_check = t + 0.5 * w;  // the transient decays; try again later
+      next_tail_check = t + 0.5 * w_;  // the transient decays; try again later
     }
     if (reset_needed) {
       integ.reset(t, y);
-      set_root_offsets(rs, t, y.data());
+      set_root_offsets(rs_, t, y.data());
     }
   }
+  return finish(integ);
+}
 
-  out.steps = integ.steps();
-  out.rhs_evaluations = rs.rhs_evals;
-  out.max_amplitude_mm = peak_amp;
-  for (std::size_t i = 0; i < rs.n; ++i) out.beta_final.push_back(wrap_angle(y[lay.beta(i)]));
+RunOutcome Run::finish(const Integrator& integ) {
+  out_.steps = integ.steps();
+  out_.rhs_evaluations = rs_.rhs_evals;
+  out_.max_amplitude_mm = peak_amp_;
+  for (std::size_t i = 0; i < rs_.n; ++i) out_.beta_final.push_back(wrap_angle(y_[lay_.beta(i)]));
   double ix = 0, iy = 0;
-  AbuModel::imbalance_vector(p, out.beta_final.data(), ix, iy);
-  out.residual_imbalance_kgm = std::hypot(ix, iy);
-  out.residual_imbalance_x_kgm = std::fabs(ix);
-  out.settled = out.ok() && all_stuck(rs, y.data());
-  out.settling_time_s = out.settled ? all_stuck_since / w : 0.0;
+  AbuModel::imbalance_vector(p_, out_.beta_final.data(), ix, iy);
+  out_.residual_imbalance_kgm = std::hypot(ix, iy);
+  out_.residual_imbalance_x_kgm = std::fabs(ix);
+  out_.settled = out_.ok() && all_stuck(rs_, y_.data());
+  out_.settling_time_s = out_.settled ? all_stuck_since_ / w_ : 0.0;
+  return out_;
+}
+
+}  // namespace
+
+RunOutcome Simulator::run(const std::vector<double>& beta0, const RunOverrides& ov,
+                          std::vector<TrajectoryPoint>* trajectory) const {
+  const auto wall0 = std::chrono::steady_clock::now();
+  if (beta0.size() != setup_.abu.balls.size())
+    throw ConfigError("the ABU has " + std::to_string(setup_.abu.balls.size()) + " balls, but " +
+                      std::to_string(beta0.size()) + " initial angles were given");
+  Run run(setup_, end_time_s(), beta0, ov, trajectory);
+  RunOutcome out = run.execute();
   out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return out;
 }
