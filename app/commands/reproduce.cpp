@@ -1,6 +1,6 @@
 // abuopt reproduce: runs the 2003 report's studies (configs/report/*.yaml) and prints every table
 // side by side with the published values, plus a verdict per published conclusion. The work is in
-// core/reproduction.hpp; this file parses options, finds the study files and prints.
+// studies/reproduction.hpp; this file parses options, finds the study files and prints.
 #include <unistd.h>
 
 #include <chrono>
@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "abuopt/common/config_error.hpp"
-#include "abuopt/core/reproduction.hpp"
+#include "abuopt/studies/reproduction.hpp"
 #include "commands/commands.hpp"
 
 namespace abuopt::app {

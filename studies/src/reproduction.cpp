@@ -1,4 +1,4 @@
-#include "abuopt/core/reproduction.hpp"
+#include "abuopt/studies/reproduction.hpp"
 
 #include <algorithm>
 #include <cctype>

@@ -1,7 +1,7 @@
 // Reproduction studies: the shipped study files carry every published number of spec section 7,
 // the YAML merge and its error messages, --runs, the conclusion checks on hand-made statistics,
 // and a tiny end-to-end run of the library.
-#include "abuopt/core/reproduction.hpp"
+#include "abuopt/studies/reproduction.hpp"
 
 #include <gtest/gtest.h>
 
