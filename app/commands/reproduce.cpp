@@ -76,14 +76,14 @@ int run_reproduce(const ReproduceArgs& a) {
   if (a.runs && *a.runs < 1) throw ConfigError("--runs", std::to_string(*a.runs), "must be >= 1");
 
   const std::string dir = find_configs(a.configs);
-  std::vector<ReproductionTable> tables = select_tables(read_reproduction_tables(dir), a.only);
+  std::vector<ReproductionTable> tables = select_tables(read_reproduction_tables(dir), a.only, "--only");
 
   ReproductionOptions opt;
   opt.out_dir = a.out.empty() ? default_out_dir() : a.out;
   opt.threads = a.threads ? static_cast<std::size_t>(*a.threads) : 0;
   opt.plots = !a.no_plots;
   opt.command_line = command_line(a, opt.out_dir);
-  if (a.runs) opt.runs_note = override_runs(tables, static_cast<std::size_t>(*a.runs));
+  if (a.runs) opt.runs_note = override_runs(tables, static_cast<std::size_t>(*a.runs), "--runs");
   opt.log = [](const std::string& line) { std::cerr << line << std::endl; };
 
   std::size_t cases = 0, runs = 0;

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/gnuplot.hpp"
@@ -17,12 +18,12 @@ using namespace studies_detail;
 
 ReproductionReport run_reproduction(const std::vector<ReproductionTable>& tables, const ReproductionOptions& opt) {
   using clock = std::chrono::steady_clock;
-  if (opt.out_dir.empty()) throw ConfigError("--out", "<empty>", "must name an output directory");
+  if (opt.out_dir.empty()) throw std::invalid_argument("run_reproduction: ReproductionOptions::out_dir is empty");
   const fs::path out(opt.out_dir);
   std::error_code ec;
   fs::create_directories(out / "runs", ec);
   if (!ec) fs::create_directories(out / "plots", ec);
-  if (ec) throw ConfigError("--out", opt.out_dir, "cannot be created (" + ec.message() + ")");
+  if (ec) throw ConfigError("output directory", opt.out_dir, "cannot be created (" + ec.message() + ")");
   auto log = [&opt](const std::string& line) {
     if (opt.log) opt.log(line);
   };
@@ -31,7 +32,7 @@ ReproductionReport run_reproduction(const std::vector<ReproductionTable>& tables
   report.markdown_path = (out / "report.md").string();
   report.tables_csv_path = (out / "tables.csv").string();
   std::ofstream tables_csv(report.tables_csv_path);
-  if (!tables_csv) throw ConfigError("--out", opt.out_dir, "cannot write " + report.tables_csv_path);
+  if (!tables_csv) throw ConfigError("output directory", opt.out_dir, "cannot write " + report.tables_csv_path);
   tables_csv << tables_csv_header() << '\n' << std::flush;
 
   ThreadPoolRunner runner(opt.threads);
@@ -46,14 +47,14 @@ ReproductionReport run_reproduction(const std::vector<ReproductionTable>& tables
     const auto t_table = clock::now();
     const fs::path run_dir = out / "runs" / table_dir_name(table.id);
     fs::create_directories(run_dir, ec);
-    if (ec) throw ConfigError("--out", opt.out_dir, "cannot create " + run_dir.string());
+    if (ec) throw ConfigError("output directory", opt.out_dir, "cannot create " + run_dir.string());
     for (std::size_t k = 0; k < table.cases.size(); ++k) {
       const ReproductionCase& c = table.cases[k];
       MonteCarloResult result = run_monte_carlo(c.study, runner);
       const fs::path csv_path = run_dir / (c.id + ".csv");
       {
         std::ofstream f(csv_path);
-        if (!f) throw ConfigError("--out", opt.out_dir, "cannot write " + csv_path.string());
+        if (!f) throw ConfigError("output directory", opt.out_dir, "cannot write " + csv_path.string());
         write_runs_csv(f, result.samples);
       }
       CaseSummary s = summarize_case(table, c, result);

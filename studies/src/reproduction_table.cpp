@@ -286,8 +286,8 @@ std::vector<ReproductionTable> select_tables(const std::vector<ReproductionTable
   return out;
 }
 
-std::string override_runs(std::vector<ReproductionTable>& tables, std::size_t runs) {
-  if (runs < 1) throw ConfigError("--runs", std::to_string(runs), "must be >= 1");
+std::string override_runs(std::vector<ReproductionTable>& tables, std::size_t runs, const std::string& name) {
+  if (runs < 1) throw ConfigError(name, std::to_string(runs), "must be >= 1");
   std::set<std::string> grids;
   for (ReproductionTable& t : tables)
     for (ReproductionCase& c : t.cases) {
@@ -299,12 +299,12 @@ std::string override_runs(std::vector<ReproductionTable>& tables, std::size_t ru
       c.study.design.kind = InitialConditionKind::Grid;
       c.study.design.grid_points_per_axis = n;
       c.study.runs = total;
-      validate(c.study, "--runs");
+      validate(c.study, name);
       std::string g = std::to_string(n);
       for (std::size_t b = 1; b < balls; ++b) g += " x " + std::to_string(n);
       grids.insert(g + " grid = " + std::to_string(total) + " runs");
     }
-  std::string text = "--runs " + std::to_string(runs) + ": every case uses ";
+  std::string text = name + " " + std::to_string(runs) + ": every case uses ";
   bool first = true;
   for (const std::string& g : grids) {
     text += (first ? "" : ", or ") + g;

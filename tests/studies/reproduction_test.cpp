@@ -301,7 +301,7 @@ TEST(ReproductionReading, SelectTablesByIdAndUnknownIds) {
     FAIL() << "no error";
   } catch (const ConfigError& e) {
     const std::string m = e.what();
-    EXPECT_NE(m.find("--only = 4.5"), std::string::npos) << m;
+    EXPECT_NE(m.find("table ids = 4.5"), std::string::npos) << m;
     EXPECT_NE(m.find("4.1, 4.2, 4.3, 4.4, final, mu"), std::string::npos) << m;
   }
 }

@@ -120,14 +120,16 @@ std::vector<ReproductionTable> read_reproduction_tables(const std::string& dir);
 const std::vector<std::string>& report_table_ids();
 
 // The tables whose id is in `ids` (in the tables' order). Throws ConfigError naming `option` when
-// an id is unknown (the message lists the available ids). Empty `ids`: all tables.
+// an id is unknown (the message lists the available ids; the app passes its flag's name). Empty
+// `ids`: all tables.
 std::vector<ReproductionTable> select_tables(const std::vector<ReproductionTable>& tables,
                                             const std::vector<std::string>& ids,
-                                            const std::string& option = "--only");
+                                            const std::string& option = "table ids");
 
-// --runs N: every case gets an n^balls grid with n = round(N^(1/balls)) (n x n for two balls),
-// runs = n^balls. Returns a sentence for the output ("--runs 1000: every case uses a 32 x 32 grid
-// = 1024 runs"). Throws ConfigError for N < 1.
-std::string override_runs(std::vector<ReproductionTable>& tables, std::size_t runs);
+// Every case gets an n^balls grid with n = round(runs^(1/balls)) (n x n for two balls), so
+// runs = n^balls. Returns a sentence for the output, starting with `name` and the number
+// ("runs 1000: every case uses a 32 x 32 grid = 1024 runs ..."; the app passes its flag's name).
+// Throws ConfigError naming `name` for runs < 1 or a study that breaks its limits.
+std::string override_runs(std::vector<ReproductionTable>& tables, std::size_t runs, const std::string& name = "runs");
 
 }  // namespace abuopt
