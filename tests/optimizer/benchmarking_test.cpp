@@ -9,7 +9,7 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/optimizer/benchmarking.hpp"
-#include "abuopt/problems/benchmarks/benchmark_factory.hpp"
+#include "abuopt/optimizer/benchmarks/benchmark_factory.hpp"
 
 namespace {
 

@@ -14,7 +14,7 @@
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/optimizer/sao.hpp"
 #include "abuopt/optimizer/sao_intervening.hpp"
-#include "abuopt/problems/benchmarks/benchmark_factory.hpp"
+#include "abuopt/optimizer/benchmarks/benchmark_factory.hpp"
 
 namespace {
 

@@ -18,7 +18,7 @@
 #include "abuopt/optimizer/evaluation_archive.hpp"
 #include "abuopt/optimizer/minimize.hpp"
 #include "abuopt/optimizer/sao.hpp"
-#include "abuopt/problems/benchmarks/benchmark_factory.hpp"
+#include "abuopt/optimizer/benchmarks/benchmark_factory.hpp"
 
 namespace {
 

@@ -1,4 +1,4 @@
-#include "abuopt/problems/benchmarks/two_bar_truss.hpp"
+#include "abuopt/optimizer/benchmarks/two_bar_truss.hpp"
 
 #include <cmath>
 

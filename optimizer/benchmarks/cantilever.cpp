@@ -1,4 +1,4 @@
-#include "abuopt/problems/benchmarks/cantilever.hpp"
+#include "abuopt/optimizer/benchmarks/cantilever.hpp"
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "abuopt/problems/benchmarks/hs071.hpp"
+#include "abuopt/optimizer/benchmarks/hs071.hpp"
 
 namespace abuopt::problems {
 

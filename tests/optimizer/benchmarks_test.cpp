@@ -7,12 +7,12 @@
 #include <cmath>
 
 #include "abuopt/common/config_error.hpp"
-#include "abuopt/problems/benchmarks/benchmark_factory.hpp"
-#include "abuopt/problems/benchmarks/cantilever.hpp"
-#include "abuopt/problems/benchmarks/hs071.hpp"
-#include "abuopt/problems/benchmarks/noisy_problem.hpp"
-#include "abuopt/problems/benchmarks/rosenbrock.hpp"
-#include "abuopt/problems/benchmarks/two_bar_truss.hpp"
+#include "abuopt/optimizer/benchmarks/benchmark_factory.hpp"
+#include "abuopt/optimizer/benchmarks/cantilever.hpp"
+#include "abuopt/optimizer/benchmarks/hs071.hpp"
+#include "abuopt/optimizer/benchmarks/noisy_problem.hpp"
+#include "abuopt/optimizer/benchmarks/rosenbrock.hpp"
+#include "abuopt/optimizer/benchmarks/two_bar_truss.hpp"
 
 namespace {
 

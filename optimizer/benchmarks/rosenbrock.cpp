@@ -1,4 +1,4 @@
-#include "abuopt/problems/benchmarks/rosenbrock.hpp"
+#include "abuopt/optimizer/benchmarks/rosenbrock.hpp"
 
 #include "abuopt/common/config_error.hpp"
 

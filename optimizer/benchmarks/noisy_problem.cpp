@@ -1,4 +1,4 @@
-#include "abuopt/problems/benchmarks/noisy_problem.hpp"
+#include "abuopt/optimizer/benchmarks/noisy_problem.hpp"
 
 #include <cmath>
 #include <cstring>

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "abuopt/optimizer/minimize.hpp"
-#include "abuopt/problems/benchmarks/benchmark_factory.hpp"
+#include "abuopt/optimizer/benchmarks/benchmark_factory.hpp"
 
 namespace {
 
