@@ -7,7 +7,7 @@
 #include "abuopt/optimizer/benchmarks/rosenbrock.hpp"
 #include "abuopt/optimizer/benchmarks/two_bar_truss.hpp"
 
-namespace abuopt::problems {
+namespace abuopt::opt::benchmarks {
 
 namespace {
 const std::vector<std::string> kBase = {"rosenbrock", "hs071", "cantilever", "two_bar_truss"};
@@ -40,4 +40,4 @@ std::unique_ptr<opt::Problem> make_benchmark(const std::string& name, const Benc
   return std::make_unique<NoisyProblem>(std::move(base), settings.noise_amplitude, settings.noise_seed);
 }
 
-}  // namespace abuopt::problems
+}  // namespace abuopt::opt::benchmarks

@@ -5,7 +5,7 @@
 
 #include "abuopt/common/config_error.hpp"
 
-namespace abuopt::problems {
+namespace abuopt::opt::benchmarks {
 
 namespace {
 std::uint64_t splitmix64(std::uint64_t z) {
@@ -44,4 +44,4 @@ opt::Evaluation NoisyProblem::evaluate(const std::vector<double>& x) {
   return e;
 }
 
-}  // namespace abuopt::problems
+}  // namespace abuopt::opt::benchmarks
