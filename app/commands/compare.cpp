@@ -65,7 +65,7 @@ opt::ProblemSpec read_startup_profile_problem(YamlReader& r) {
   section.finish();
   problems::StartupProfileProblem check(settings);  // a bad design is a ConfigError now, before any run
   spec.label = r.get_string_or("label", "startup_profile");
-  spec.make = [settings] { return std::make_unique<problems::StartupProfileProblem>(settings); };
+  spec.make = [settings] { return problems::make_startup_profile_problem(settings); };
   read_run_settings(r, spec);
   r.finish();
   return spec;

@@ -22,6 +22,7 @@
 #include "abuopt/optimizer/evaluation_archive.hpp"
 #include "abuopt/optimizer/minimize.hpp"
 #include "abuopt/optimizer/optimizer_options.hpp"
+#include "abuopt/optimizer/penalty_problem.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
 #include "commands/commands.hpp"
 
@@ -223,8 +224,12 @@ int run_optimize(const OptimizeArgs& a) {
   LoadedConfig cfg = load_config(a);
   StartupProfileProblem problem(cfg.settings);
   const auto& st = problem.settings();
+  // What the optimiser sees: the problem, or its penalty form (constraints.penalty_weight > 0).
+  std::optional<opt::PenaltyProblem> penalised;
+  if (st.constraints.penalty_weight > 0) penalised.emplace(problem, st.constraints.penalty_weight);
+  opt::Problem& optimised = penalised ? static_cast<opt::Problem&>(*penalised) : problem;
   const std::vector<opt::Variable> vars = problem.variables();
-  const std::vector<std::string> g_names = problem.inequality_names();
+  const std::vector<std::string> g_names = optimised.inequality_names();
 
   const fs::path out = a.out.empty() ? fs::path("results") / fs::path(a.config).stem() : fs::path(a.out);
   std::error_code ec;
@@ -232,7 +237,7 @@ int run_optimize(const OptimizeArgs& a) {
   if (ec) throw ConfigError("--out", out.string(), "cannot be created (" + ec.message() + ")");
   const std::string id = problem.identity();
   opt::EvaluationArchive archive((out / "archive.sqlite").string(), id);
-  opt::ArchivedProblem archived(problem, archive);
+  opt::ArchivedProblem archived(optimised, archive);
   cfg.options.sao.archive = &archive;  // SAO: archived points inform its surrogates
 
   // Progress to stdout, or to stderr with --json (stdout then holds the JSON alone).
@@ -354,15 +359,16 @@ int run_optimize(const OptimizeArgs& a) {
         << ") for the best design and for the report's final profile ...\n"
         << std::flush;
     const StartupProfile best = problem.profile_at(r.x), report = StartupProfile::report_final();
+    auto as_optimised = [&](opt::Evaluation e) { return penalised ? penalised->penalise(std::move(e)) : e; };
     opt::Evaluation best_in;
     best_in.objective = r.objective;
     best_in.inequality = r.inequality;
     best_in.metrics = r.metrics;
     const std::vector<Row> rows = {
         {"best, in-sample (" + std::to_string(st.study.runs) + ")", best_in},
-        {"best, out-of-sample (" + std::to_string(v.runs) + ")", problem.evaluate_out_of_sample(best)},
-        {"report profile, in-sample", problem.evaluate_profile(report)},
-        {"report profile, out-of-sample", problem.evaluate_out_of_sample(report)},
+        {"best, out-of-sample (" + std::to_string(v.runs) + ")", as_optimised(problem.evaluate_out_of_sample(best))},
+        {"report profile, in-sample", as_optimised(problem.evaluate_profile(report))},
+        {"report profile, out-of-sample", as_optimised(problem.evaluate_out_of_sample(report))},
     };
     log << comparison_table(rows);
     log << "  report profile: " << profile_text(report) << "\n";
