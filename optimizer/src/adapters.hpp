@@ -10,7 +10,7 @@
 namespace abuopt::opt::detail {
 
 struct AdapterOutcome {
-  TerminationReason reason = TerminationReason::failure;
+  TerminationReason reason = TerminationReason::Failure;
   std::string message;
   std::string algorithm_label;  // e.g. "AUGLAG(BOBYQA)"
   long iterations = 0;

@@ -214,7 +214,7 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
           // e.g. a bound-only global algorithm on a constrained problem: recorded as a failed run
           rec.result.problem_name = problem->name();
           rec.result.algorithm = o.algorithm;
-          rec.result.reason = TerminationReason::failure;
+          rec.result.reason = TerminationReason::Failure;
           rec.result.message = e.what();
         }
         double best = kInf;

@@ -170,7 +170,7 @@ class SaoRun {
     m_eq_ = driver.n_equality();
   }
 
-  TerminationReason reason = TerminationReason::failure;
+  TerminationReason reason = TerminationReason::Failure;
   std::string message;
   long iterations = 0;
 
@@ -793,19 +793,19 @@ void SaoRun::run(const std::vector<double>& x0) {
   int stalled = 0;
   while (true) {
     if (radius_ < sao_.min_radius) {
-      reason = TerminationReason::converged_xtol;
+      reason = TerminationReason::ConvergedXtol;
       message = "trust region radius " + format_number(radius_) + " below min_radius " +
                 format_number(sao_.min_radius);
       return;
     }
     if (stalled >= sao_.stall_iterations) {
-      reason = TerminationReason::converged_ftol;
+      reason = TerminationReason::ConvergedFtol;
       message = "no improvement of the merit by more than stall_tolerance in " +
                 std::to_string(sao_.stall_iterations) + " iterations";
       return;
     }
     if (options_.max_iterations > 0 && iterations >= options_.max_iterations) {
-      reason = TerminationReason::max_iterations;
+      reason = TerminationReason::MaxIterations;
       message = "iteration limit of " + std::to_string(options_.max_iterations) + " reached";
       return;
     }
@@ -907,7 +907,7 @@ AdapterOutcome run_sao(EvaluationDriver& driver, Problem& problem, const Optimiz
     out.reason = run.reason;
     out.message = run.message;
   } catch (const std::exception& ex) {
-    out.reason = TerminationReason::failure;
+    out.reason = TerminationReason::Failure;
     out.message = std::string("SAO threw: ") + ex.what();
   }
   out.iterations = run.iterations;

@@ -178,7 +178,7 @@ TEST(Comparison, ReadSolverSpec) {
   EXPECT_EQ(a.options.sao.surrogate, "quadratic");
   const opt::SolverSpec b = opt::read_solver_spec(entries[1]);
   EXPECT_EQ(b.label, "slsqp");
-  EXPECT_EQ(b.options.finite_difference, opt::FiniteDifference::central);
+  EXPECT_EQ(b.options.finite_difference, opt::FiniteDifference::Central);
   try {
     opt::read_solver_spec(entries[2]);
     FAIL() << "no ConfigError";

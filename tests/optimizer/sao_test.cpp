@@ -139,7 +139,7 @@ TEST(Sao, BudgetStopReturnsBestFeasiblePoint) {
   opt::OptimizerOptions o;
   o.max_evaluations = 30;
   const opt::OptimizationResult r = opt::minimize_sao(*problem, o, opt::SaoOptions{});
-  EXPECT_EQ(r.reason, opt::TerminationReason::max_evaluations);
+  EXPECT_EQ(r.reason, opt::TerminationReason::MaxEvaluations);
   EXPECT_EQ(r.evaluations, 30);
   EXPECT_FALSE(r.success());
   ASSERT_TRUE(r.has_feasible_point());

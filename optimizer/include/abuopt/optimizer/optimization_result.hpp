@@ -16,25 +16,25 @@
 namespace abuopt::opt {
 
 enum class TerminationReason {
-  converged,            // the algorithm's own convergence test (no finer reason given)
-  converged_ftol,       // change of f below ftol_rel / ftol_abs
-  converged_xtol,       // change of x below xtol_rel (or Ipopt: search direction too small)
-  target_reached,       // a feasible point with f <= target
-  max_evaluations,      // evaluation budget used up
-  max_iterations,       // iteration limit (Ipopt)
-  max_time,             // wall-clock (or Ipopt CPU) limit
-  stopped_by_callback,  // the evaluation callback returned false
-  interrupted,          // SIGINT (Ctrl-C) or request_stop()
-  evaluation_error,     // an evaluation threw an exception
-  infeasible,           // the algorithm stopped without a feasible point
-  roundoff_limited,     // NLopt: roundoff errors limited progress
-  failure,              // the algorithm failed (message says why)
+  Converged,           // the algorithm's own convergence test (no finer reason given)
+  ConvergedFtol,       // change of f below ftol_rel / ftol_abs
+  ConvergedXtol,       // change of x below xtol_rel (or Ipopt: search direction too small)
+  TargetReached,       // a feasible point with f <= target
+  MaxEvaluations,      // evaluation budget used up
+  MaxIterations,       // iteration limit (Ipopt)
+  MaxTime,             // wall-clock (or Ipopt CPU) limit
+  StoppedByCallback,   // the evaluation callback returned false
+  Interrupted,         // SIGINT (Ctrl-C) or request_stop()
+  EvaluationError,     // an evaluation threw an exception
+  Infeasible,          // the algorithm stopped without a feasible point
+  RoundoffLimited,     // NLopt: roundoff errors limited progress
+  Failure,             // the algorithm failed (message says why)
 };
 
 std::string to_string(TerminationReason reason);
 // Inverse of to_string; throws abuopt::ConfigError listing the valid names.
 TerminationReason termination_reason_from_string(const std::string& text);
-// converged, converged_ftol, converged_xtol, target_reached.
+// Converged, ConvergedFtol, ConvergedXtol, TargetReached.
 bool is_convergence(TerminationReason reason);
 
 // One evaluation as the optimiser saw it.
@@ -58,7 +58,7 @@ struct EvaluationRecord {
 struct OptimizationResult {
   std::string problem_name;
   std::string algorithm;           // as run, e.g. "AUGLAG(BOBYQA)"
-  TerminationReason reason = TerminationReason::failure;
+  TerminationReason reason = TerminationReason::Failure;
   std::string message;             // human-readable detail of the reason
 
   // Best point: the feasible point with the lowest objective; if no point was feasible, the
