@@ -14,6 +14,7 @@ struct AdapterOutcome {
   std::string message;
   std::string algorithm_label;  // e.g. "AUGLAG(BOBYQA)"
   long iterations = 0;
+  std::vector<IterationRecord> records;  // SAO
 };
 
 // `x0` in real units, inside the bounds. `local` is used for AUGLAG / MLSL_LDS and for wrapping a

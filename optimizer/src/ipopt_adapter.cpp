@@ -122,26 +122,26 @@ class DriverTnlp : public Ipopt::TNLP {
 AdapterOutcome map_status(Ipopt::ApplicationReturnStatus s) {
   using R = TerminationReason;
   switch (s) {
-    case Ipopt::Solve_Succeeded: return {R::Converged, "Ipopt: optimal solution found", "", 0};
+    case Ipopt::Solve_Succeeded: return {R::Converged, "Ipopt: optimal solution found", "", 0, {}};
     case Ipopt::Solved_To_Acceptable_Level:
-      return {R::Converged, "Ipopt: solved to an acceptable level (acceptable_tol)", "", 0};
-    case Ipopt::Infeasible_Problem_Detected: return {R::Infeasible, "Ipopt: converged to a point of local infeasibility", "", 0};
+      return {R::Converged, "Ipopt: solved to an acceptable level (acceptable_tol)", "", 0, {}};
+    case Ipopt::Infeasible_Problem_Detected: return {R::Infeasible, "Ipopt: converged to a point of local infeasibility", "", 0, {}};
     case Ipopt::Search_Direction_Becomes_Too_Small:
-      return {R::ConvergedXtol, "Ipopt: search direction became too small", "", 0};
-    case Ipopt::Diverging_Iterates: return {R::Failure, "Ipopt: iterates diverging", "", 0};
-    case Ipopt::User_Requested_Stop: return {R::StoppedByCallback, "Ipopt: stopped on request", "", 0};
-    case Ipopt::Feasible_Point_Found: return {R::Converged, "Ipopt: feasible point found", "", 0};
-    case Ipopt::Maximum_Iterations_Exceeded: return {R::MaxIterations, "Ipopt: maximum number of iterations", "", 0};
-    case Ipopt::Restoration_Failed: return {R::Failure, "Ipopt: restoration phase failed", "", 0};
-    case Ipopt::Error_In_Step_Computation: return {R::Failure, "Ipopt: error in step computation", "", 0};
-    case Ipopt::Maximum_CpuTime_Exceeded: return {R::MaxTime, "Ipopt: maximum CPU time exceeded", "", 0};
+      return {R::ConvergedXtol, "Ipopt: search direction became too small", "", 0, {}};
+    case Ipopt::Diverging_Iterates: return {R::Failure, "Ipopt: iterates diverging", "", 0, {}};
+    case Ipopt::User_Requested_Stop: return {R::StoppedByCallback, "Ipopt: stopped on request", "", 0, {}};
+    case Ipopt::Feasible_Point_Found: return {R::Converged, "Ipopt: feasible point found", "", 0, {}};
+    case Ipopt::Maximum_Iterations_Exceeded: return {R::MaxIterations, "Ipopt: maximum number of iterations", "", 0, {}};
+    case Ipopt::Restoration_Failed: return {R::Failure, "Ipopt: restoration phase failed", "", 0, {}};
+    case Ipopt::Error_In_Step_Computation: return {R::Failure, "Ipopt: error in step computation", "", 0, {}};
+    case Ipopt::Maximum_CpuTime_Exceeded: return {R::MaxTime, "Ipopt: maximum CPU time exceeded", "", 0, {}};
     case Ipopt::Not_Enough_Degrees_Of_Freedom:
-      return {R::Failure, "Ipopt: not enough degrees of freedom (more equality constraints than variables?)", "", 0};
-    case Ipopt::Invalid_Problem_Definition: return {R::Failure, "Ipopt: invalid problem definition", "", 0};
-    case Ipopt::Invalid_Option: return {R::Failure, "Ipopt: invalid option", "", 0};
+      return {R::Failure, "Ipopt: not enough degrees of freedom (more equality constraints than variables?)", "", 0, {}};
+    case Ipopt::Invalid_Problem_Definition: return {R::Failure, "Ipopt: invalid problem definition", "", 0, {}};
+    case Ipopt::Invalid_Option: return {R::Failure, "Ipopt: invalid option", "", 0, {}};
     case Ipopt::Invalid_Number_Detected:
-      return {R::Failure, "Ipopt: invalid number (NaN/inf) in the problem functions", "", 0};
-    default: return {R::Failure, "Ipopt: internal error (status " + std::to_string(static_cast<int>(s)) + ")", "", 0};
+      return {R::Failure, "Ipopt: invalid number (NaN/inf) in the problem functions", "", 0, {}};
+    default: return {R::Failure, "Ipopt: internal error (status " + std::to_string(static_cast<int>(s)) + ")", "", 0, {}};
   }
 }
 

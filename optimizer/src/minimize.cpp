@@ -82,6 +82,7 @@ OptimizationResult minimize(Problem& problem, const OptimizerOptions& options, s
   r.algorithm = outcome.algorithm_label;
   r.x0 = x0;
   r.iterations = outcome.iterations;
+  r.iteration_records = std::move(outcome.records);
   for (const Variable& v : problem.variables()) r.variable_names.push_back(v.name);
   r.inequality_names = problem.inequality_names();
   r.equality_names = problem.equality_names();

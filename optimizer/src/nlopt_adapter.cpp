@@ -98,22 +98,22 @@ void set_tolerances(nlopt_opt o, const OptimizerOptions& options, const Evaluati
 AdapterOutcome map_result(nlopt_result r, EvaluationDriver& d) {
   AdapterOutcome out;
   switch (r) {
-    case NLOPT_SUCCESS: out = {TerminationReason::Converged, "NLopt: success", "", 0}; break;
-    case NLOPT_STOPVAL_REACHED: out = {TerminationReason::TargetReached, "NLopt: stopval reached", "", 0}; break;
-    case NLOPT_FTOL_REACHED: out = {TerminationReason::ConvergedFtol, "NLopt: ftol_rel or ftol_abs reached", "", 0}; break;
-    case NLOPT_XTOL_REACHED: out = {TerminationReason::ConvergedXtol, "NLopt: xtol_rel reached", "", 0}; break;
+    case NLOPT_SUCCESS: out = {TerminationReason::Converged, "NLopt: success", "", 0, {}}; break;
+    case NLOPT_STOPVAL_REACHED: out = {TerminationReason::TargetReached, "NLopt: stopval reached", "", 0, {}}; break;
+    case NLOPT_FTOL_REACHED: out = {TerminationReason::ConvergedFtol, "NLopt: ftol_rel or ftol_abs reached", "", 0, {}}; break;
+    case NLOPT_XTOL_REACHED: out = {TerminationReason::ConvergedXtol, "NLopt: xtol_rel reached", "", 0, {}}; break;
     case NLOPT_MAXEVAL_REACHED:
       out = {TerminationReason::MaxEvaluations,
-             "NLopt's own call limit (10 x max_evaluations + 100, counting repeated points) reached", "", 0};
+             "NLopt's own call limit (10 x max_evaluations + 100, counting repeated points) reached", "", 0, {}};
       break;
-    case NLOPT_MAXTIME_REACHED: out = {TerminationReason::MaxTime, "NLopt: maxtime reached", "", 0}; break;
-    case NLOPT_FORCED_STOP: out = {TerminationReason::Failure, "NLopt: forced stop", "", 0}; break;
+    case NLOPT_MAXTIME_REACHED: out = {TerminationReason::MaxTime, "NLopt: maxtime reached", "", 0, {}}; break;
+    case NLOPT_FORCED_STOP: out = {TerminationReason::Failure, "NLopt: forced stop", "", 0, {}}; break;
     case NLOPT_ROUNDOFF_LIMITED:
-      out = {TerminationReason::RoundoffLimited, "NLopt: roundoff errors limited progress", "", 0};
+      out = {TerminationReason::RoundoffLimited, "NLopt: roundoff errors limited progress", "", 0, {}};
       break;
-    case NLOPT_OUT_OF_MEMORY: out = {TerminationReason::Failure, "NLopt: out of memory", "", 0}; break;
-    case NLOPT_INVALID_ARGS: out = {TerminationReason::Failure, "NLopt: invalid arguments", "", 0}; break;
-    default: out = {TerminationReason::Failure, "NLopt: failure", "", 0}; break;
+    case NLOPT_OUT_OF_MEMORY: out = {TerminationReason::Failure, "NLopt: out of memory", "", 0, {}}; break;
+    case NLOPT_INVALID_ARGS: out = {TerminationReason::Failure, "NLopt: invalid arguments", "", 0, {}}; break;
+    default: out = {TerminationReason::Failure, "NLopt: failure", "", 0, {}}; break;
   }
   (void)d;
   return out;

@@ -54,6 +54,16 @@ TerminationReason termination_reason_from_string(const std::string& text) {
   throw ConfigError("termination reason", text, "unknown; valid: " + valid);
 }
 
+std::string to_string(IterationStep step) {
+  switch (step) {
+    case IterationStep::Accepted: return "accepted";
+    case IterationStep::Rejected: return "rejected";
+    case IterationStep::NoPredictedReduction: return "no_predicted_reduction";
+    case IterationStep::NoModel: return "no_model";
+  }
+  return "unknown";
+}
+
 bool is_convergence(TerminationReason r) {
   return r == TerminationReason::Converged || r == TerminationReason::ConvergedFtol ||
          r == TerminationReason::ConvergedXtol || r == TerminationReason::TargetReached;
