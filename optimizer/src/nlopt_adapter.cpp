@@ -125,7 +125,11 @@ AdapterOutcome run_nlopt(EvaluationDriver& d, const AlgorithmInfo& algorithm, co
                          bool wrap_in_auglag, const OptimizerOptions& options, const std::vector<double>& x0) {
   const unsigned n = static_cast<unsigned>(d.n());
   const bool uses_local = wrap_in_auglag || algorithm.needs_local;
-  const AlgorithmInfo& inner = wrap_in_auglag ? algorithm : *local;
+  // the algorithm that solves AUGLAG's / MLSL's sub-problems (none for a plain run: never bind a
+  // reference to *local then, local is null)
+  const AlgorithmInfo* inner = wrap_in_auglag ? &algorithm : local;
+  if (uses_local && !inner)
+    throw std::invalid_argument("run_nlopt: " + algorithm.name + " needs a local algorithm and none was given");
 
   nlopt_algorithm outer_code = nlopt_code(algorithm.name);
   std::string label = algorithm.name;
@@ -141,7 +145,8 @@ AdapterOutcome run_nlopt(EvaluationDriver& d, const AlgorithmInfo& algorithm, co
   if (!opt) throw std::runtime_error("nlopt_create failed for " + label);
   OptPtr local_opt;
   if (uses_local) {
-    local_opt.reset(nlopt_create(nlopt_code(inner.name), n));
+    local_opt.reset(nlopt_create(nlopt_code(inner->name), n));
+    if (!local_opt) throw std::runtime_error("nlopt_create failed for " + inner->name);
     set_tolerances(local_opt.get(), options, d);
   }
 
