@@ -23,6 +23,7 @@
 #include "abuopt/optimizer/evaluation_archive.hpp"
 #include "abuopt/optimizer/minimize.hpp"
 #include "abuopt/optimizer/optimizer_options.hpp"
+#include "abuopt/optimizer/penalty_problem.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
 #include "abuopt/studies/out_of_sample.hpp"
 #include "commands/commands.hpp"
@@ -180,8 +181,12 @@ int run_optimize(const OptimizeArgs& a) {
   LoadedConfig cfg = load_config(a);
   StartupProfileProblem problem(cfg.settings);
   const auto& st = problem.settings();
+  // What the optimiser sees: the problem, or its penalty form (constraints.penalty_weight > 0).
+  std::optional<opt::PenaltyProblem> penalised;
+  if (st.constraints.penalty_weight > 0) penalised.emplace(problem, st.constraints.penalty_weight);
+  opt::Problem& optimised = penalised ? static_cast<opt::Problem&>(*penalised) : problem;
   const std::vector<opt::Variable> vars = problem.variables();
-  const std::vector<std::string> g_names = problem.inequality_names();
+  const std::vector<std::string> g_names = optimised.inequality_names();
 
   const fs::path out = a.out.empty() ? fs::path("results") / fs::path(a.config).stem() : fs::path(a.out);
   std::error_code ec;
@@ -189,7 +194,7 @@ int run_optimize(const OptimizeArgs& a) {
   if (ec) throw ConfigError("--out", out.string(), "cannot be created (" + ec.message() + ")");
   const std::string id = problem.identity();
   opt::EvaluationArchive archive((out / "archive.sqlite").string(), id);
-  opt::ArchivedProblem archived(problem, archive);
+  opt::ArchivedProblem archived(optimised, archive);
   cfg.options.sao.archive = &archive;  // SAO: archived points inform its surrogates
 
   // Progress to stdout, or to stderr with --json (stdout then holds the JSON alone).
@@ -304,13 +309,13 @@ int run_optimize(const OptimizeArgs& a) {
   auto write_json = [&] { open_out(result_json) << j.dump(2) << "\n"; };
   write_json();
 
-  const bool interrupted = r.reason == opt::TerminationReason::interrupted;
+  const bool interrupted = r.reason == opt::TerminationReason::Interrupted;
   if (have_best && st.validation.enabled && !interrupted) {
     const auto& v = st.validation;
     log << "\nvalidation: " << v.runs << " fresh initial conditions (" << to_string(v.design) << ", seed " << v.seed
         << ") for the best design and for the report's final profile ...\n"
         << std::flush;
-    const OutOfSampleComparison cmp = compare_out_of_sample(problem, r);
+    const OutOfSampleComparison cmp = compare_out_of_sample(problem, r, penalised ? &*penalised : nullptr);
     const StartupProfile& report = cmp.report;
     const std::vector<ComparisonRow>& rows = cmp.rows;
     log << comparison_table(rows);

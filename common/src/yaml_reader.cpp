@@ -1,6 +1,8 @@
 #include "abuopt/common/yaml_reader.hpp"
 
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <sstream>
 
 namespace abuopt {
@@ -93,16 +95,17 @@ YAML::Node YamlReader::at(const std::string& key) {
 
 double YamlReader::scalar_as_double(const YAML::Node& n, const std::string& path, const Rule& rule) {
   if (!n.IsScalar()) throw ConfigError(path, yaml_value_text(n), "must be a number");
-  double v = 0;
   const std::string& s = n.Scalar();
-  try {
-    size_t used = 0;
-    v = std::stod(s, &used);
-    while (used < s.size() && std::isspace(static_cast<unsigned char>(s[used]))) ++used;
-    if (used != s.size()) throw std::invalid_argument("trailing");
-  } catch (const std::exception&) {
+  // strtod, not stod: stod rejects subnormal values (5e-324) as out of range, so a number that
+  // was written could not be read back. An overflow (1e400) is still not a number.
+  const char* begin = s.c_str();
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(begin, &end);
+  const bool overflow = errno == ERANGE && std::isinf(v);
+  while (end && *end != '\0' && std::isspace(static_cast<unsigned char>(*end))) ++end;
+  if (end == begin || end == nullptr || *end != '\0' || overflow || s.find('\0') != std::string::npos)
     throw ConfigError(path, s, "must be a number");
-  }
   const std::string broken = rule.check ? rule.check(v) : std::string();
   if (!broken.empty()) throw ConfigError(path, s, broken);
   return v;

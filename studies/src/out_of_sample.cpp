@@ -21,7 +21,9 @@ std::string metric_cell(const opt::Evaluation& e, const std::string& key, int wi
 }  // namespace
 
 OutOfSampleComparison compare_out_of_sample(const problems::StartupProfileProblem& problem,
-                                            const opt::OptimizationResult& r) {
+                                            const opt::OptimizationResult& r,
+                                            const opt::PenaltyProblem* penalty) {
+  auto as_optimised = [&](opt::Evaluation e) { return penalty ? penalty->penalise(std::move(e)) : e; };
   const auto& st = problem.settings();
   const auto& v = st.validation;
   OutOfSampleComparison c{problem.profile_at(r.x), StartupProfile::report_final(), {}};
@@ -31,9 +33,9 @@ OutOfSampleComparison compare_out_of_sample(const problems::StartupProfileProble
   best_in.metrics = r.metrics;
   c.rows = {
       {"best, in-sample (" + std::to_string(st.study.runs) + ")", best_in},
-      {"best, out-of-sample (" + std::to_string(v.runs) + ")", problem.evaluate_out_of_sample(c.best)},
-      {"report profile, in-sample", problem.evaluate_profile(c.report)},
-      {"report profile, out-of-sample", problem.evaluate_out_of_sample(c.report)},
+      {"best, out-of-sample (" + std::to_string(v.runs) + ")", as_optimised(problem.evaluate_out_of_sample(c.best))},
+      {"report profile, in-sample", as_optimised(problem.evaluate_profile(c.report))},
+      {"report profile, out-of-sample", as_optimised(problem.evaluate_out_of_sample(c.report))},
   };
   return c;
 }

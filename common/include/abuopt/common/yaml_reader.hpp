@@ -70,6 +70,9 @@ class YamlReader {
   // Throws if the node at `key` exists but is not a sequence/mapping.
   bool is_sequence(const std::string& key) const;
 
+  // Counts `key` as read without reading it (a caller that reads it another way).
+  void mark_read(const std::string& key) { read_.insert(key); }
+
   // Throws ConfigError for the first key of this mapping that was never read.
   void finish() const;
 

@@ -9,6 +9,7 @@
 
 #include "abuopt/core/profile.hpp"
 #include "abuopt/optimizer/optimization_result.hpp"
+#include "abuopt/optimizer/penalty_problem.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
 
 namespace abuopt {
@@ -26,9 +27,12 @@ struct OutOfSampleComparison {
 };
 
 // Evaluates the four rows (the best design's in-sample row is taken from `r`, not recomputed).
-// `r` must have a best point (r.x not empty).
+// `r` must have a best point (r.x not empty). When the optimiser saw the penalty form of the
+// problem (`penalty` not null), the recomputed rows are penalised the same way, so that every
+// row's objective is the one the optimiser minimised.
 OutOfSampleComparison compare_out_of_sample(const problems::StartupProfileProblem& problem,
-                                            const opt::OptimizationResult& r);
+                                            const opt::OptimizationResult& r,
+                                            const opt::PenaltyProblem* penalty = nullptr);
 
 // The rows as a fixed-width table for the terminal (objective, mean |I_r| and I_r,x, %MI, %LC,
 // amplitude, startup time, failed runs).
