@@ -123,6 +123,9 @@ std::string to_string(ObjectiveKind k) {
     case ObjectiveKind::mean: return "mean";
     case ObjectiveKind::pct_mi: return "pct_mi";
     case ObjectiveKind::weighted: return "weighted";
+    case ObjectiveKind::smooth_pct_mi: return "smooth_pct_mi";
+    case ObjectiveKind::quantile: return "quantile";
+    case ObjectiveKind::cvar: return "cvar";
   }
   return "?";
 }
@@ -175,8 +178,15 @@ StartupProfileSettings read_startup_profile_settings(YamlReader& root) {
   s.design = read_profile_design(root.child("design"), s.study.setup.profile);
 
   YamlReader o = root.child("objective");
-  const std::string kind = o.get_choice_or("kind", "mean", {"mean", "pct_mi", "weighted"});
-  s.objective.kind = kind == "mean" ? ObjectiveKind::mean : kind == "pct_mi" ? ObjectiveKind::pct_mi : ObjectiveKind::weighted;
+  const std::vector<std::string> kinds = {"mean", "pct_mi", "weighted", "smooth_pct_mi", "quantile", "cvar"};
+  const std::string kind = o.get_choice_or("kind", "mean", kinds);
+  s.objective.kind = static_cast<ObjectiveKind>(std::find(kinds.begin(), kinds.end(), kind) - kinds.begin());
+  if (o.has("level")) {
+    if (s.objective.kind != ObjectiveKind::quantile && s.objective.kind != ObjectiveKind::cvar)
+      throw ConfigError(o.key_path("level"), yaml_value_text(o.node()["level"]),
+                        "is only used with objective.kind: quantile or cvar");
+    s.objective.level = o.get_double("level", Rule::in_range(1e-9, 0.999999));
+  }
   s.objective.definition = o.get_choice_or("definition", "magnitude", {"magnitude", "report_x"}) == "magnitude"
                                ? ImbalanceDefinition::magnitude
                                : ImbalanceDefinition::report_x;
@@ -210,6 +220,7 @@ StartupProfileSettings read_startup_profile_settings(YamlReader& root) {
   s.constraints.amplitude =
       c.get_choice_or("amplitude", "max", {"max", "mean"}) == "max" ? AmplitudeStatistic::max : AmplitudeStatistic::mean;
   s.constraints.penalty_weight = c.get_double_or("penalty_weight", 0.0, Rule::non_negative());
+  s.constraints.smooth_pct_mi = c.get_choice_or("pct_mi_statistic", "exact", {"exact", "smooth"}) == "smooth";
   c.finish();
 
   YamlReader v = root.child("validation");
@@ -371,12 +382,23 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
   auto ir = [x_def](const MonteCarloStats& st) -> const ResidualImbalanceStats& {
     return x_def ? st.report_x : st.magnitude;
   };
-  auto objective_of = [&](const MonteCarloStats& st) {
+  const bool smooth_objective = os.kind == ObjectiveKind::smooth_pct_mi || os.kind == ObjectiveKind::quantile ||
+                                os.kind == ObjectiveKind::cvar;
+  const bool smooth_wanted = smooth_objective || settings_.constraints.smooth_pct_mi;
+  auto objective_of = [&](const MonteCarloStats& st, const std::vector<MonteCarloSample>& samples) {
     const double mean = ir(st).mean / kUnit, pct = ir(st).pct_mi;
     switch (os.kind) {
       case ObjectiveKind::mean: return mean;
       case ObjectiveKind::pct_mi: return pct;
       case ObjectiveKind::weighted: return os.weight_mean * mean + os.weight_pct_mi * pct;
+      case ObjectiveKind::smooth_pct_mi:
+      case ObjectiveKind::quantile:
+      case ObjectiveKind::cvar: {
+        const SmoothImbalanceStats sm = compute_smooth_statistics(samples, x_def, os.level);
+        return os.kind == ObjectiveKind::smooth_pct_mi ? sm.pct_mi
+               : os.kind == ObjectiveKind::quantile    ? sm.quantile / kUnit
+                                                       : sm.cvar / kUnit;
+      }
     }
     return mean;
   };
@@ -413,11 +435,13 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
     if (ps.ok == 0)
       return opt::Evaluation::failed("every run failed" +
                                      (mu ? " at friction mu = " + format_number(*mu) : std::string()));
-    objectives.push_back(objective_of(ps));
+    objectives.push_back(objective_of(ps, r.samples));
     pass_pct_mi.push_back(ir(ps).pct_mi);
     for (auto& s : r.samples) pooled.push_back(std::move(s));
   }
   const MonteCarloStats all = compute_statistics(pooled);
+  SmoothImbalanceStats smooth;
+  if (smooth_wanted) smooth = compute_smooth_statistics(pooled, x_def, os.level);
 
   opt::Evaluation e;
   auto& m = e.metrics;
@@ -438,6 +462,12 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
   m["runs"] = static_cast<double>(all.runs);
   m["failed_runs"] = static_cast<double>(all.failed);
   m["mc_wall_time_s"] = wall;
+  if (smooth_wanted) {
+    m["pct_mi_smooth"] = smooth.pct_mi;
+    m["ir_quantile"] = smooth.quantile / kUnit;
+    m["ir_cvar"] = smooth.cvar / kUnit;
+    m["smoothing_bandwidth"] = smooth.bandwidth;
+  }
   if (passes.size() > 1 || passes.front()) {
     for (std::size_t k = 0; k < passes.size(); ++k) {
       const std::string tag = std::to_string(k + 1);
@@ -466,7 +496,7 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
     const double a = c.amplitude == AmplitudeStatistic::max ? all.amplitude_max_mm : all.amplitude_mean_mm;
     g.push_back(a / *c.max_amplitude_mm - 1.0);
   }
-  if (c.max_pct_mi) g.push_back(ir(all).pct_mi / *c.max_pct_mi - 1.0);
+  if (c.max_pct_mi) g.push_back((c.smooth_pct_mi ? smooth.pct_mi : ir(all).pct_mi) / *c.max_pct_mi - 1.0);
   e.inequality = std::move(g);
   return e;
 }
@@ -502,6 +532,10 @@ std::string StartupProfileProblem::identity_text() const {
      << ", max_amplitude_mm: " << opt_text(c.max_amplitude_mm) << ", amplitude: " << to_string(c.amplitude)
      << ", max_pct_mi: " << opt_text(c.max_pct_mi) << ", penalty_weight: " << format_number(c.penalty_weight)
      << "}\n";
+  // keys added later: written only when not at their default, so older identities stay valid
+  if (o.kind == ObjectiveKind::quantile || o.kind == ObjectiveKind::cvar)
+    os << "objective_level: " << format_number(o.level) << "\n";
+  if (c.smooth_pct_mi) os << "constraints_pct_mi_statistic: smooth\n";
   return os.str();
 }
 
