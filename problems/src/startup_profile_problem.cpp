@@ -58,7 +58,14 @@ void check_value(const DesignValue& v, const std::string& path, bool duration) {
 }  // namespace
 
 const EnumNames<ObjectiveKind> kObjectiveKindNames = {
-    {ObjectiveKind::Mean, "mean"}, {ObjectiveKind::PctMi, "pct_mi"}, {ObjectiveKind::Weighted, "weighted"}};
+    {ObjectiveKind::Mean, "mean"},
+    {ObjectiveKind::PctMi, "pct_mi"},
+    {ObjectiveKind::Weighted, "weighted"},
+    {ObjectiveKind::SmoothPctMi, "smooth_pct_mi"},
+    {ObjectiveKind::Quantile, "quantile"},
+    {ObjectiveKind::Cvar, "cvar"}};
+const EnumNames<PctMiStatistic> kPctMiStatisticNames = {{PctMiStatistic::Exact, "exact"},
+                                                        {PctMiStatistic::Smooth, "smooth"}};
 const EnumNames<ImbalanceDefinition> kImbalanceDefinitionNames = {{ImbalanceDefinition::Magnitude, "magnitude"},
                                                                   {ImbalanceDefinition::ReportX, "report_x"}};
 const EnumNames<AmplitudeStatistic> kAmplitudeStatisticNames = {{AmplitudeStatistic::Max, "max"},
@@ -127,6 +134,9 @@ void describe_design_fields(FieldArchive& a, ProfileDesign& d, const StartupProf
 void describe_fields(FieldArchive& a, ObjectiveSettings& o) {
   a.field("kind", o.kind, kObjectiveKindNames);
   a.field("definition", o.definition, kImbalanceDefinitionNames);
+  a.field("level", o.level, Rule::in_range(1e-9, 0.999999),
+          FieldOptions::only_if(o.kind == ObjectiveKind::Quantile || o.kind == ObjectiveKind::Cvar,
+                                "is only used with objective.kind: quantile or cvar"));
   const bool weighted = o.kind == ObjectiveKind::Weighted;
   if (a.reading() && weighted && !a.has("weights"))
     throw ConfigError(a.path("weights"), "<missing>", "is required with objective.kind: weighted ({mean: w1, pct_mi: w2})");
@@ -148,6 +158,9 @@ void describe_fields(FieldArchive& a, ConstraintSettings& c) {
   a.field("max_pct_mi", c.max_pct_mi, Rule::in_range(1e-9, 100.0));
   a.field("amplitude", c.amplitude, kAmplitudeStatisticNames);
   a.field("penalty_weight", c.penalty_weight, Rule::non_negative());
+  FieldOptions statistic;  // written (and in the identity) only when not the default exact count
+  statistic.enabled = a.reading() || c.pct_mi_statistic != PctMiStatistic::Exact;
+  a.field("pct_mi_statistic", c.pct_mi_statistic, kPctMiStatisticNames, statistic);
 }
 
 // The validation section; its defaults follow the Monte Carlo section (seed + 1) and the balls.
@@ -348,12 +361,24 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
   auto ir = [x_def](const MonteCarloStats& st) -> const ResidualImbalanceStats& {
     return x_def ? st.report_x : st.magnitude;
   };
-  auto objective_of = [&](const MonteCarloStats& st) {
+  const bool smooth_objective = os.kind == ObjectiveKind::SmoothPctMi || os.kind == ObjectiveKind::Quantile ||
+                                os.kind == ObjectiveKind::Cvar;
+  const bool smooth_constraint = settings_.constraints.pct_mi_statistic == PctMiStatistic::Smooth;
+  const bool smooth_wanted = smooth_objective || smooth_constraint;
+  auto objective_of = [&](const MonteCarloStats& st, const std::vector<MonteCarloSample>& samples) {
     const double mean = ir(st).mean / kUnit, pct = ir(st).pct_mi;
     switch (os.kind) {
       case ObjectiveKind::Mean: return mean;
       case ObjectiveKind::PctMi: return pct;
       case ObjectiveKind::Weighted: return os.weight_mean * mean + os.weight_pct_mi * pct;
+      case ObjectiveKind::SmoothPctMi:
+      case ObjectiveKind::Quantile:
+      case ObjectiveKind::Cvar: {
+        const SmoothImbalanceStats sm = compute_smooth_statistics(samples, x_def, os.level);
+        return os.kind == ObjectiveKind::SmoothPctMi ? sm.pct_mi
+               : os.kind == ObjectiveKind::Quantile  ? sm.quantile / kUnit
+                                                     : sm.cvar / kUnit;
+      }
     }
     return mean;
   };
@@ -390,11 +415,13 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
     if (ps.ok == 0)
       return opt::Evaluation::failed("every run failed" +
                                      (mu ? " at friction mu = " + format_number(*mu) : std::string()));
-    objectives.push_back(objective_of(ps));
+    objectives.push_back(objective_of(ps, r.samples));
     pass_pct_mi.push_back(ir(ps).pct_mi);
     for (auto& s : r.samples) pooled.push_back(std::move(s));
   }
   const MonteCarloStats all = compute_statistics(pooled);
+  SmoothImbalanceStats smooth;
+  if (smooth_wanted) smooth = compute_smooth_statistics(pooled, x_def, os.level);
 
   opt::Evaluation e;
   auto& m = e.metrics;
@@ -415,6 +442,12 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
   m["runs"] = static_cast<double>(all.runs);
   m["failed_runs"] = static_cast<double>(all.failed);
   m["mc_wall_time_s"] = wall;
+  if (smooth_wanted) {
+    m["pct_mi_smooth"] = smooth.pct_mi;
+    m["ir_quantile"] = smooth.quantile / kUnit;
+    m["ir_cvar"] = smooth.cvar / kUnit;
+    m["smoothing_bandwidth"] = smooth.bandwidth;
+  }
   if (passes.size() > 1 || passes.front()) {
     for (std::size_t k = 0; k < passes.size(); ++k) {
       const std::string tag = std::to_string(k + 1);
@@ -443,7 +476,7 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
     const double a = c.amplitude == AmplitudeStatistic::Max ? all.amplitude_max_mm : all.amplitude_mean_mm;
     g.push_back(a / *c.max_amplitude_mm - 1.0);
   }
-  if (c.max_pct_mi) g.push_back(ir(all).pct_mi / *c.max_pct_mi - 1.0);
+  if (c.max_pct_mi) g.push_back((smooth_constraint ? smooth.pct_mi : ir(all).pct_mi) / *c.max_pct_mi - 1.0);
   e.inequality = std::move(g);
   return e;
 }

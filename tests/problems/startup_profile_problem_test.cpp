@@ -169,6 +169,40 @@ TEST(StartupProfileProblem, ObjectiveKindsMatchTheEngineStatistics) {
   EXPECT_DOUBLE_EQ(w.evaluate(x).objective, 2 * st.magnitude.mean / 1e-7 + 0.5 * st.magnitude.pct_mi);
 }
 
+// The smooth objectives are core's smooth statistics of the same runs; the pct_mi constraint can use
+// the smoothed exceedance; the identity changes with them and not for the older keys.
+TEST(StartupProfileProblem, SmoothObjectivesAndConstraintAreTheEngineSmoothStatistics) {
+  const std::vector<double> x = {35, 0.4};
+  StartupProfileProblem base(settings_from(tiny("{kind: mean}")));
+  MonteCarloStudy study = base.settings().study;
+  study.setup.profile = base.profile_at(x);
+  ThreadPoolRunner runner(1);
+  const std::vector<MonteCarloSample> samples = run_monte_carlo(study, runner).samples;
+  const SmoothImbalanceStats s90 = compute_smooth_statistics(samples, false, 0.9);
+  const SmoothImbalanceStats s75 = compute_smooth_statistics(samples, false, 0.75);
+
+  StartupProfileProblem smooth(settings_from(tiny("{kind: smooth_pct_mi}")));
+  const opt::Evaluation e = smooth.evaluate(x);
+  ASSERT_TRUE(e.ok) << e.message;
+  EXPECT_DOUBLE_EQ(e.objective, s90.pct_mi);
+  EXPECT_DOUBLE_EQ(e.metrics.at("pct_mi_smooth"), s90.pct_mi);
+  EXPECT_DOUBLE_EQ(e.metrics.at("smoothing_bandwidth"), s90.bandwidth);
+  StartupProfileProblem q(settings_from(tiny("{kind: quantile, level: 0.75}")));
+  EXPECT_DOUBLE_EQ(q.evaluate(x).objective, s75.quantile / 1e-7);
+  StartupProfileProblem cv(settings_from(tiny("{kind: cvar}")));
+  EXPECT_DOUBLE_EQ(cv.evaluate(x).objective, s90.cvar / 1e-7);
+  EXPECT_GE(cv.evaluate(x).objective, q.evaluate(x).objective);
+
+  StartupProfileProblem g(settings_from(tiny("{kind: mean}", "{max_pct_mi: 40, pct_mi_statistic: smooth}")));
+  EXPECT_DOUBLE_EQ(g.evaluate(x).inequality.at(0), s90.pct_mi / 40 - 1.0);
+  EXPECT_FALSE(base.evaluate(x).metrics.count("pct_mi_smooth"));  // the default outputs are unchanged
+
+  EXPECT_NE(q.identity(), StartupProfileProblem(settings_from(tiny("{kind: quantile, level: 0.8}"))).identity());
+  EXPECT_NE(g.identity(), StartupProfileProblem(settings_from(tiny("{kind: mean}", "{max_pct_mi: 40}"))).identity());
+  EXPECT_EQ(error_of([] { settings_from(tiny("{kind: mean, level: 0.5}")); }),
+            "objective.level = 0.5: is only used with objective.kind: quantile or cvar");
+}
+
 TEST(StartupProfileProblem, RobustObjectiveIsTheMeanOverFrictionValues) {
   const std::vector<double> x = {35, 0.4};
   StartupProfileProblem robust(settings_from(tiny("{kind: weighted, weights: {mean: 1, pct_mi: 1}, robust: {friction_mu: [0.02, 0.04]}}")));
@@ -375,7 +409,7 @@ TEST(StartupProfileProblem, ConfigErrorsNameKeyValueAndRule) {
   EXPECT_EQ(err(head), "design = <missing>: is required (design: {segments: [...]} with at least one free {min, max} value)");
   const std::string design = "design: {segments: [{end_frequency_hz: 30, duration_s: {min: 1, max: 2}}]}\n";
   EXPECT_EQ(err(head + design + "objective: {kind: median}\n"),
-            "objective.kind = median: must be one of: mean, pct_mi, weighted");
+            "objective.kind = median: must be one of: mean, pct_mi, weighted, smooth_pct_mi, quantile, cvar");
   EXPECT_EQ(err(head + design + "objective: {kind: mean, weights: {mean: 1}}\n"),
             "objective.weights = {mean: 1}: is only used with objective.kind: weighted");
   EXPECT_EQ(err(head + design + "objective: {kind: weighted, weights: {mean: 0, pct_mi: 0}}\n"),
