@@ -12,6 +12,7 @@
 #include "abuopt/core/batch_runner.hpp"
 #include "abuopt/core/monte_carlo_stats.hpp"
 #include "abuopt/core/simulation_config.hpp"
+#include "abuopt/optimizer/penalty_problem.hpp"
 
 namespace abuopt::problems {
 
@@ -277,9 +278,13 @@ StartupProfileProblem::StartupProfileProblem(StartupProfileSettings settings) : 
   if (c.max_pct_mi) constraint_names_.push_back("pct_mi");
 }
 
-std::vector<std::string> StartupProfileProblem::inequality_names() const {
-  if (settings_.constraints.penalty_weight > 0) return {};
-  return constraint_names_;
+std::vector<std::string> StartupProfileProblem::inequality_names() const { return constraint_names_; }
+
+std::unique_ptr<opt::Problem> make_startup_profile_problem(const StartupProfileSettings& settings) {
+  auto problem = std::make_unique<StartupProfileProblem>(settings);
+  const double w = settings.constraints.penalty_weight;
+  if (w > 0) return std::make_unique<opt::PenaltyProblem>(std::move(problem), w);
+  return problem;
 }
 
 std::vector<double> StartupProfileProblem::initial_point() const { return x0_; }
@@ -439,17 +444,7 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
     g.push_back(a / *c.max_amplitude_mm - 1.0);
   }
   if (c.max_pct_mi) g.push_back(ir(all).pct_mi / *c.max_pct_mi - 1.0);
-  if (c.penalty_weight > 0) {
-    m["objective_without_penalty"] = e.objective;
-    double pen = 0;
-    for (std::size_t i = 0; i < g.size(); ++i) {
-      m["g_" + constraint_names_[i]] = g[i];
-      pen += std::max(0.0, g[i]);
-    }
-    e.objective += c.penalty_weight * pen;
-  } else {
-    e.inequality = std::move(g);
-  }
+  e.inequality = std::move(g);
   return e;
 }
 

@@ -14,7 +14,7 @@
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/optimizer/sao.hpp"
 #include "abuopt/optimizer/sao_intervening.hpp"
-#include "abuopt/problems/benchmarks/benchmark_factory.hpp"
+#include "abuopt/optimizer/benchmarks/benchmark_factory.hpp"
 
 namespace {
 
@@ -192,7 +192,7 @@ TEST(InterveningVariables, OptionsAreValidatedAndRead) {
 // of 1 / x^3); the [measure] lines give the evaluations to 1 % of best_known.
 TEST(InterveningVariables, EveryFormSolvesTheCantilever) {
   for (const std::string form : {"linear", "reciprocal", "exponential", "auto"}) {
-    auto problem = problems::make_benchmark("cantilever");
+    auto problem = opt::benchmarks::make_benchmark("cantilever");
     const double f_star = problem->best_known()->objective;
     opt::OptimizerOptions o;
     o.max_evaluations = 300;

@@ -18,7 +18,7 @@
 #include "abuopt/optimizer/evaluation_archive.hpp"
 #include "abuopt/optimizer/minimize.hpp"
 #include "abuopt/optimizer/sao.hpp"
-#include "abuopt/problems/benchmarks/benchmark_factory.hpp"
+#include "abuopt/optimizer/benchmarks/benchmark_factory.hpp"
 
 namespace {
 
@@ -51,7 +51,7 @@ class SaoConvergence : public testing::TestWithParam<Case> {};
 
 TEST_P(SaoConvergence, ReachesBestKnown) {
   const Case& c = GetParam();
-  auto problem = problems::make_benchmark(c.problem);
+  auto problem = opt::benchmarks::make_benchmark(c.problem);
   const opt::BestKnown best = *problem->best_known();
   opt::OptimizerOptions o;
   o.max_evaluations = c.budget;
@@ -91,7 +91,7 @@ INSTANTIATE_TEST_SUITE_P(Noisy, SaoConvergence,
 class SaoVersusCobyla : public testing::TestWithParam<std::string> {};
 
 TEST_P(SaoVersusCobyla, EvaluationsToOnePercent) {
-  auto problem = problems::make_benchmark(GetParam());
+  auto problem = opt::benchmarks::make_benchmark(GetParam());
   const double f_star = problem->best_known()->objective;
   opt::OptimizerOptions o;
   o.max_evaluations = 1000;
@@ -117,7 +117,7 @@ TEST(Sao, InfeasibleStartReachesFeasibleOptimum) {
   };
   for (const Start& st : {Start{"cantilever", {2, 2, 2, 2, 2}}, Start{"hs071", {1, 1, 1, 1}},
                           Start{"two_bar_truss", {0.3, 1.5}}}) {
-    auto problem = problems::make_benchmark(st.problem);
+    auto problem = opt::benchmarks::make_benchmark(st.problem);
     const opt::Evaluation e0 = problem->evaluate(st.x0);
     ASSERT_GT(opt::max_constraint_violation(e0), 0.1) << st.problem << ": the start must be infeasible";
     opt::OptimizerOptions o;
@@ -135,7 +135,7 @@ TEST(Sao, InfeasibleStartReachesFeasibleOptimum) {
 // Stopped by the evaluation budget: the best FEASIBLE point of the history is returned (not the
 // last iterate, not an infeasible point with a lower objective), and the run is not a success.
 TEST(Sao, BudgetStopReturnsBestFeasiblePoint) {
-  auto problem = problems::make_benchmark("cantilever");
+  auto problem = opt::benchmarks::make_benchmark("cantilever");
   opt::OptimizerOptions o;
   o.max_evaluations = 30;
   const opt::OptimizationResult r = opt::minimize_sao(*problem, o, opt::SaoOptions{});
@@ -206,7 +206,7 @@ TEST(Sao, NoiseAwareRatioTestOnPiecewiseConstantResponse) {
 
 // The points of an attached archive inform the surrogates and are not evaluated again.
 TEST(Sao, ReusesArchivedPoints) {
-  auto problem = problems::make_benchmark("two_bar_truss");
+  auto problem = opt::benchmarks::make_benchmark("two_bar_truss");
   const std::string path = std::string(ABUOPT_BINARY_DIR) + "/sao_test_archive.sqlite";
   std::remove(path.c_str());
   opt::OptimizerOptions o;
@@ -237,7 +237,7 @@ TEST(Sao, ReusesArchivedPoints) {
 
 // minimize_any dispatches "sao" (any case) to minimize_sao and everything else to minimize.
 TEST(Sao, MinimizeAnyDispatchesByName) {
-  auto problem = problems::make_benchmark("two_bar_truss");
+  auto problem = opt::benchmarks::make_benchmark("two_bar_truss");
   opt::OptimizerOptions o;
   o.algorithm = "Sao";
   o.max_evaluations = 200;
@@ -336,7 +336,7 @@ TEST(SaoOptions, ReadFromYaml) {
 // Every surrogate and DOE choice runs and reaches the truss optimum.
 TEST(Sao, EverySurrogateChoiceWorks) {
   for (const std::string surrogate : {"linear", "interactions", "pure_quadratic", "quadratic", "kriging"}) {
-    auto problem = problems::make_benchmark("two_bar_truss");
+    auto problem = opt::benchmarks::make_benchmark("two_bar_truss");
     opt::OptimizerOptions o;
     o.max_evaluations = 300;
     opt::SaoOptions sao;

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <string>
 
 #include "abuopt/common/config_error.hpp"
@@ -207,11 +208,14 @@ TEST(StartupProfileProblem, ConstraintValuesAreRelativeToTheirBounds) {
   EXPECT_DOUBLE_EQ(m.inequality[0], m.metrics.at("amplitude_mean_mm") / 2 - 1.0);
   EXPECT_LE(m.metrics.at("amplitude_mean_mm"), m.metrics.at("amplitude_max_mm"));
 
-  // Penalty form: no declared constraints, objective + w * sum max(0, g).
-  StartupProfileProblem pen(
-      settings_from(tiny("{kind: mean}", "{max_startup_time_s: 0.3, max_pct_mi: 40, penalty_weight: 10}")));
-  EXPECT_TRUE(pen.inequality_names().empty());
-  const opt::Evaluation q = pen.evaluate(x);
+  // Penalty form: no declared constraints, objective + w * sum max(0, g); the problem itself keeps
+  // its constraints.
+  const StartupProfileSettings pen_settings =
+      settings_from(tiny("{kind: mean}", "{max_startup_time_s: 0.3, max_pct_mi: 40, penalty_weight: 10}"));
+  EXPECT_EQ(StartupProfileProblem(pen_settings).inequality_names().size(), 2u);
+  const std::unique_ptr<opt::Problem> pen = problems::make_startup_profile_problem(pen_settings);
+  EXPECT_TRUE(pen->inequality_names().empty());
+  const opt::Evaluation q = pen->evaluate(x);
   EXPECT_TRUE(q.inequality.empty());
   const double g_time = 0.4 / 0.3 - 1.0, g_mi = q.metrics.at("pct_mi") / 40 - 1.0;
   EXPECT_DOUBLE_EQ(q.metrics.at("g_startup_time"), g_time);

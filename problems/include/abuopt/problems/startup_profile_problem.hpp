@@ -26,8 +26,9 @@
 //   amplitude:     A / max_amplitude_mm - 1 <= 0, A = max over runs of the peak amplitude
 //                  (amplitude: max, default) or the mean over runs of it (amplitude: mean)
 //   pct_mi:        %MI / max_pct_mi - 1 <= 0                    (definition of the objective)
-// With constraints.penalty_weight = w > 0 the problem declares NO constraints (for bound-only
-// optimisers) and minimises objective + w * sum_i max(0, g_i) instead (exact L1 penalty).
+// The problem always declares its constraints. With constraints.penalty_weight = w > 0 the
+// optimisers see its penalty form instead (make_startup_profile_problem, opt::PenaltyProblem): no
+// declared constraints (for bound-only optimisers), objective + w * sum_i max(0, g_i) (exact L1).
 //
 // A failed evaluation (opt::Evaluation::failed, never an exception): a profile with a duration
 // that is not > 0 (never simulated), every run of a pass failing, or more failed runs than
@@ -37,9 +38,11 @@
 //   ir_magnitude_{mean,median,max}, ir_x_{mean,median,max}, pct_mi_magnitude, pct_mi_x, pct_mi
 //   (the constrained/optimised definition), pct_lc, amplitude_max_mm, amplitude_mean_mm,
 //   startup_time_s, end_time_s, runs, failed_runs, mc_wall_time_s; with a robust set also
-//   objective_mu<k>, mu<k> and pct_mi_mu<k> for k = 1..K; with a penalty, g_<name> per constraint.
+//   objective_mu<k>, mu<k> and pct_mi_mu<k> for k = 1..K (the penalty form adds g_<name> per
+//   constraint and objective_without_penalty).
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -101,7 +104,7 @@ struct ConstraintSettings {
   std::optional<double> max_amplitude_mm;
   AmplitudeStatistic amplitude = AmplitudeStatistic::Max;
   std::optional<double> max_pct_mi;
-  double penalty_weight = 0.0;  // > 0: constraints folded into the objective (no declared constraints)
+  double penalty_weight = 0.0;  // > 0: optimised in penalty form (make_startup_profile_problem)
 };
 
 // The out-of-sample check of the app: a fresh, larger set of initial conditions.
@@ -197,5 +200,14 @@ class StartupProfileProblem : public opt::Problem {
   std::vector<Slot> slots_;
   std::vector<std::string> constraint_names_;
 };
+
+}  // namespace abuopt::problems
+
+namespace abuopt::problems {
+
+// The problem as the optimisers see it: a StartupProfileProblem, or with
+// constraints.penalty_weight > 0 its exact-L1-penalty form (opt::PenaltyProblem owning it). Throws
+// ConfigError for invalid settings.
+std::unique_ptr<opt::Problem> make_startup_profile_problem(const StartupProfileSettings& settings);
 
 }  // namespace abuopt::problems

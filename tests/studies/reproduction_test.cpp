@@ -1,7 +1,7 @@
 // Reproduction studies: the shipped study files carry every published number of spec section 7,
 // the YAML merge and its error messages, --runs, the conclusion checks on hand-made statistics,
 // and a tiny end-to-end run of the library.
-#include "abuopt/core/reproduction.hpp"
+#include "abuopt/studies/reproduction.hpp"
 
 #include <gtest/gtest.h>
 
@@ -301,7 +301,7 @@ TEST(ReproductionReading, SelectTablesByIdAndUnknownIds) {
     FAIL() << "no error";
   } catch (const ConfigError& e) {
     const std::string m = e.what();
-    EXPECT_NE(m.find("--only = 4.5"), std::string::npos) << m;
+    EXPECT_NE(m.find("table ids = 4.5"), std::string::npos) << m;
     EXPECT_NE(m.find("4.1, 4.2, 4.3, 4.4, final, mu"), std::string::npos) << m;
   }
 }

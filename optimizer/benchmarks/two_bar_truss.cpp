@@ -1,8 +1,8 @@
-#include "abuopt/problems/benchmarks/two_bar_truss.hpp"
+#include "abuopt/optimizer/benchmarks/two_bar_truss.hpp"
 
 #include <cmath>
 
-namespace abuopt::problems {
+namespace abuopt::opt::benchmarks {
 
 std::vector<opt::Variable> TwoBarTruss::variables() const {
   return {{"area", 0.2, 4.0, 1.0}, {"span_ratio", 0.1, 1.6, 0.5}};
@@ -27,4 +27,4 @@ std::optional<opt::BestKnown> TwoBarTruss::best_known() const {
   return opt::BestKnown{{x1, x2}, x1 * r};
 }
 
-}  // namespace abuopt::problems
+}  // namespace abuopt::opt::benchmarks

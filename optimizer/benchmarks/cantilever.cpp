@@ -1,8 +1,8 @@
-#include "abuopt/problems/benchmarks/cantilever.hpp"
+#include "abuopt/optimizer/benchmarks/cantilever.hpp"
 
 #include <cmath>
 
-namespace abuopt::problems {
+namespace abuopt::opt::benchmarks {
 
 namespace {
 constexpr double kWeight = 0.0624;
@@ -43,4 +43,4 @@ std::optional<opt::BestKnown> Cantilever::best_known() const {
   return best;
 }
 
-}  // namespace abuopt::problems
+}  // namespace abuopt::opt::benchmarks

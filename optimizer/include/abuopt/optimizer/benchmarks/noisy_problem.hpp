@@ -9,7 +9,7 @@
 
 #include "abuopt/optimizer/problem.hpp"
 
-namespace abuopt::problems {
+namespace abuopt::opt::benchmarks {
 
 class NoisyProblem : public opt::Problem {
  public:
@@ -33,4 +33,4 @@ class NoisyProblem : public opt::Problem {
   std::uint64_t seed_;
 };
 
-}  // namespace abuopt::problems
+}  // namespace abuopt::opt::benchmarks

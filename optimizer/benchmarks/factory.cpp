@@ -1,13 +1,13 @@
-#include "abuopt/problems/benchmarks/benchmark_factory.hpp"
+#include "abuopt/optimizer/benchmarks/benchmark_factory.hpp"
 
 #include "abuopt/common/config_error.hpp"
-#include "abuopt/problems/benchmarks/cantilever.hpp"
-#include "abuopt/problems/benchmarks/hs071.hpp"
-#include "abuopt/problems/benchmarks/noisy_problem.hpp"
-#include "abuopt/problems/benchmarks/rosenbrock.hpp"
-#include "abuopt/problems/benchmarks/two_bar_truss.hpp"
+#include "abuopt/optimizer/benchmarks/cantilever.hpp"
+#include "abuopt/optimizer/benchmarks/hs071.hpp"
+#include "abuopt/optimizer/benchmarks/noisy_problem.hpp"
+#include "abuopt/optimizer/benchmarks/rosenbrock.hpp"
+#include "abuopt/optimizer/benchmarks/two_bar_truss.hpp"
 
-namespace abuopt::problems {
+namespace abuopt::opt::benchmarks {
 
 namespace {
 const std::vector<std::string> kBase = {"rosenbrock", "hs071", "cantilever", "two_bar_truss"};
@@ -40,4 +40,4 @@ std::unique_ptr<opt::Problem> make_benchmark(const std::string& name, const Benc
   return std::make_unique<NoisyProblem>(std::move(base), settings.noise_amplitude, settings.noise_seed);
 }
 
-}  // namespace abuopt::problems
+}  // namespace abuopt::opt::benchmarks

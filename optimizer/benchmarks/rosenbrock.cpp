@@ -1,8 +1,8 @@
-#include "abuopt/problems/benchmarks/rosenbrock.hpp"
+#include "abuopt/optimizer/benchmarks/rosenbrock.hpp"
 
 #include "abuopt/common/config_error.hpp"
 
-namespace abuopt::problems {
+namespace abuopt::opt::benchmarks {
 
 Rosenbrock::Rosenbrock(int dimension, double bound) : n_(dimension), bound_(bound) {
   if (dimension < 2 || dimension > 10)
@@ -55,4 +55,4 @@ std::optional<opt::BestKnown> Rosenbrock::best_known() const {
   return opt::BestKnown{std::vector<double>(n_, 1.0), 0.0};
 }
 
-}  // namespace abuopt::problems
+}  // namespace abuopt::opt::benchmarks

@@ -7,12 +7,12 @@
 #include <cmath>
 
 #include "abuopt/common/config_error.hpp"
-#include "abuopt/problems/benchmarks/benchmark_factory.hpp"
-#include "abuopt/problems/benchmarks/cantilever.hpp"
-#include "abuopt/problems/benchmarks/hs071.hpp"
-#include "abuopt/problems/benchmarks/noisy_problem.hpp"
-#include "abuopt/problems/benchmarks/rosenbrock.hpp"
-#include "abuopt/problems/benchmarks/two_bar_truss.hpp"
+#include "abuopt/optimizer/benchmarks/benchmark_factory.hpp"
+#include "abuopt/optimizer/benchmarks/cantilever.hpp"
+#include "abuopt/optimizer/benchmarks/hs071.hpp"
+#include "abuopt/optimizer/benchmarks/noisy_problem.hpp"
+#include "abuopt/optimizer/benchmarks/rosenbrock.hpp"
+#include "abuopt/optimizer/benchmarks/two_bar_truss.hpp"
 
 namespace {
 
@@ -109,18 +109,18 @@ void expect_feasible(opt::Problem& p, const std::vector<double>& x, double tol) 
 
 TEST(Rosenbrock, OptimumIsZeroAtOnesWithZeroGradient) {
   for (int n = 2; n <= 10; ++n) {
-    problems::Rosenbrock p(n);
+    opt::benchmarks::Rosenbrock p(n);
     const auto best = *p.best_known();
     EXPECT_EQ(p.evaluate(best.x).objective, 0.0);
     for (double g : p.gradient(best.x)) EXPECT_EQ(g, 0.0);
     EXPECT_EQ(p.initial_point().size(), static_cast<std::size_t>(n));
   }
-  problems::Rosenbrock p2(2);
+  opt::benchmarks::Rosenbrock p2(2);
   EXPECT_DOUBLE_EQ(p2.evaluate({-1.2, 1.0}).objective, 24.2);  // the classic starting value
 }
 
 TEST(Rosenbrock, AnalyticGradientMatchesCentralDifferences) {
-  problems::Rosenbrock p(4);
+  opt::benchmarks::Rosenbrock p(4);
   const std::vector<double> x{-1.2, 1.0, 0.3, -0.7};
   const Eigen::VectorXd fd = gradient(p, x, 0);
   const auto g = p.gradient(x);
@@ -128,12 +128,12 @@ TEST(Rosenbrock, AnalyticGradientMatchesCentralDifferences) {
 }
 
 TEST(Rosenbrock, DimensionOutsideTwoToTenIsAConfigError) {
-  EXPECT_EQ(error_of([] { problems::Rosenbrock p(1); }), "rosenbrock dimension = 1: must be in [2, 10]");
-  EXPECT_EQ(error_of([] { problems::Rosenbrock p(11); }), "rosenbrock dimension = 11: must be in [2, 10]");
+  EXPECT_EQ(error_of([] { opt::benchmarks::Rosenbrock p(1); }), "rosenbrock dimension = 1: must be in [2, 10]");
+  EXPECT_EQ(error_of([] { opt::benchmarks::Rosenbrock p(11); }), "rosenbrock dimension = 11: must be in [2, 10]");
 }
 
 TEST(Hs071, PublishedOptimumSatisfiesKkt) {
-  problems::Hs071 p;
+  opt::benchmarks::Hs071 p;
   const auto best = *p.best_known();
   EXPECT_NEAR(best.objective, 17.0140173, 1e-7);                    // the value in the brief
   EXPECT_NEAR(p.evaluate(best.x).objective, best.objective, 1e-12);
@@ -147,7 +147,7 @@ TEST(Hs071, PublishedOptimumSatisfiesKkt) {
 }
 
 TEST(Cantilever, ClosedFormOptimumSatisfiesKkt) {
-  problems::Cantilever p;
+  opt::benchmarks::Cantilever p;
   const auto best = *p.best_known();
   EXPECT_NEAR(best.objective, 1.33996, 1e-5);  // Svanberg's published value
   const std::vector<double> published{6.016, 5.309, 4.494, 3.502, 2.153};
@@ -161,7 +161,7 @@ TEST(Cantilever, ClosedFormOptimumSatisfiesKkt) {
 }
 
 TEST(TwoBarTruss, DerivedOptimumSatisfiesKkt) {
-  problems::TwoBarTruss p;
+  opt::benchmarks::TwoBarTruss p;
   const auto best = *p.best_known();
   EXPECT_NEAR(best.objective, 1.5087, 1e-4);  // Svanberg's published value (4 digits)
   EXPECT_NEAR(best.x[0], 1.4116, 1e-4);
@@ -182,8 +182,8 @@ TEST(TwoBarTruss, DerivedOptimumSatisfiesKkt) {
 }
 
 TEST(BestKnown, EveryBenchmarkIsInsideItsBounds) {
-  for (const auto& name : problems::benchmark_names()) {
-    auto p = problems::make_benchmark(name);
+  for (const auto& name : opt::benchmarks::benchmark_names()) {
+    auto p = opt::benchmarks::make_benchmark(name);
     EXPECT_NO_THROW(opt::check_problem(*p)) << name;
     EXPECT_NO_THROW(opt::check_design_vector(*p, p->best_known()->x)) << name;
     EXPECT_NO_THROW(opt::check_design_vector(*p, p->initial_point())) << name;
@@ -191,23 +191,23 @@ TEST(BestKnown, EveryBenchmarkIsInsideItsBounds) {
 }
 
 TEST(BenchmarkFactory, MakesEveryNamedProblem) {
-  EXPECT_EQ(problems::make_benchmark("rosenbrock", {.dimension = 6})->dimension(), 6u);
-  EXPECT_EQ(problems::make_benchmark("hs071")->name(), "hs071");
-  EXPECT_EQ(problems::make_benchmark("noisy_two_bar_truss")->name(), "noisy_two_bar_truss");
-  EXPECT_EQ(problems::make_benchmark("noisy_cantilever")->inequality_names(), std::vector<std::string>{"tip_deflection"});
-  EXPECT_EQ(problems::benchmark_names().size(), 8u);
+  EXPECT_EQ(opt::benchmarks::make_benchmark("rosenbrock", {.dimension = 6})->dimension(), 6u);
+  EXPECT_EQ(opt::benchmarks::make_benchmark("hs071")->name(), "hs071");
+  EXPECT_EQ(opt::benchmarks::make_benchmark("noisy_two_bar_truss")->name(), "noisy_two_bar_truss");
+  EXPECT_EQ(opt::benchmarks::make_benchmark("noisy_cantilever")->inequality_names(), std::vector<std::string>{"tip_deflection"});
+  EXPECT_EQ(opt::benchmarks::benchmark_names().size(), 8u);
 }
 
 TEST(BenchmarkFactory, UnknownNameListsTheValidOnes) {
-  EXPECT_EQ(error_of([] { problems::make_benchmark("rosenbrok"); }),
+  EXPECT_EQ(error_of([] { opt::benchmarks::make_benchmark("rosenbrok"); }),
             "benchmark = rosenbrok: unknown benchmark problem; valid: rosenbrock, hs071, cantilever, "
             "two_bar_truss, noisy_rosenbrock, noisy_hs071, noisy_cantilever, noisy_two_bar_truss");
-  EXPECT_EQ(error_of([] { problems::make_benchmark("noisy_x"); }).substr(0, 20), "benchmark = noisy_x:");
+  EXPECT_EQ(error_of([] { opt::benchmarks::make_benchmark("noisy_x"); }).substr(0, 20), "benchmark = noisy_x:");
 }
 
 TEST(NoisyProblem, RepeatsAreIdenticalAndNoiseIsBoundedBySetAmplitude) {
-  auto p = problems::make_benchmark("noisy_hs071", {.noise_amplitude = 0.01, .noise_seed = 7});
-  problems::Hs071 clean;
+  auto p = opt::benchmarks::make_benchmark("noisy_hs071", {.noise_amplitude = 0.01, .noise_seed = 7});
+  opt::benchmarks::Hs071 clean;
   const std::vector<double> x{1.5, 4.0, 3.5, 1.5};
   const opt::Evaluation a = p->evaluate(x), b = p->evaluate(x), c = clean.evaluate(x);
   EXPECT_EQ(a.objective, b.objective);  // bitwise: common random numbers
@@ -218,12 +218,12 @@ TEST(NoisyProblem, RepeatsAreIdenticalAndNoiseIsBoundedBySetAmplitude) {
   EXPECT_LE(std::fabs(a.equality[0] - c.equality[0]), 0.01 * (1 + std::fabs(c.equality[0])));
   EXPECT_EQ(a.metrics.at("noise_free_objective"), c.objective);
   // another seed, other noise; a neighbouring x, other noise
-  auto q = problems::make_benchmark("noisy_hs071", {.noise_amplitude = 0.01, .noise_seed = 8});
+  auto q = opt::benchmarks::make_benchmark("noisy_hs071", {.noise_amplitude = 0.01, .noise_seed = 8});
   EXPECT_NE(q->evaluate(x).objective, a.objective);
   std::vector<double> y = x;
   y[0] = std::nextafter(y[0], 2.0);
   EXPECT_NE(p->evaluate(y).objective, a.objective);
-  EXPECT_EQ(error_of([] { problems::make_benchmark("noisy_cantilever", {.noise_amplitude = 1.5}); }),
+  EXPECT_EQ(error_of([] { opt::benchmarks::make_benchmark("noisy_cantilever", {.noise_amplitude = 1.5}); }),
             "noise_amplitude = 1.5: must be in [0, 1)");
 }
 
@@ -231,7 +231,7 @@ TEST(NoisyProblem, UnitNoiseIsUniformInMinusOneToOne) {
   double lo = 1, hi = -1, sum = 0;
   const int n = 20000;
   for (int i = 0; i < n; ++i) {
-    const double u = problems::NoisyProblem::unit_noise({0.001 * i}, 3, 0);
+    const double u = opt::benchmarks::NoisyProblem::unit_noise({0.001 * i}, 3, 0);
     lo = std::min(lo, u);
     hi = std::max(hi, u);
     sum += u;

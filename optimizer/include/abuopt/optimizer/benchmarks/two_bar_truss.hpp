@@ -9,7 +9,7 @@
 //   x = (1.4116311, 0.3770724), f = 1.5086524 (stress_2 = -0.498, inactive).
 #include "abuopt/optimizer/problem.hpp"
 
-namespace abuopt::problems {
+namespace abuopt::opt::benchmarks {
 
 class TwoBarTruss : public opt::Problem {
  public:
@@ -21,4 +21,4 @@ class TwoBarTruss : public opt::Problem {
   std::optional<opt::BestKnown> best_known() const override;
 };
 
-}  // namespace abuopt::problems
+}  // namespace abuopt::opt::benchmarks

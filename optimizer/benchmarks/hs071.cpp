@@ -1,6 +1,6 @@
-#include "abuopt/problems/benchmarks/hs071.hpp"
+#include "abuopt/optimizer/benchmarks/hs071.hpp"
 
-namespace abuopt::problems {
+namespace abuopt::opt::benchmarks {
 
 std::vector<opt::Variable> Hs071::variables() const {
   return {{"x1", 1, 5, 1}, {"x2", 1, 5, 1}, {"x3", 1, 5, 1}, {"x4", 1, 5, 1}};
@@ -24,4 +24,4 @@ std::optional<opt::BestKnown> Hs071::best_known() const {
   return opt::BestKnown{{1.0, 4.742999637264417, 3.821149984184874, 1.3794082931726723}, 17.014017289156303};
 }
 
-}  // namespace abuopt::problems
+}  // namespace abuopt::opt::benchmarks

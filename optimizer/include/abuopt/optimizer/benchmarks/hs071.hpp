@@ -8,7 +8,7 @@
 // lower bound of x1 active (checked by the KKT test in tests/problems).
 #include "abuopt/optimizer/problem.hpp"
 
-namespace abuopt::problems {
+namespace abuopt::opt::benchmarks {
 
 class Hs071 : public opt::Problem {
  public:
@@ -21,4 +21,4 @@ class Hs071 : public opt::Problem {
   std::optional<opt::BestKnown> best_known() const override;
 };
 
-}  // namespace abuopt::problems
+}  // namespace abuopt::opt::benchmarks

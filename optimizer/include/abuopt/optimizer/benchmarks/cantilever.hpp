@@ -8,7 +8,7 @@
 //   x = (6.016016, 5.309174, 4.494330, 3.501475, 2.152665).
 #include "abuopt/optimizer/problem.hpp"
 
-namespace abuopt::problems {
+namespace abuopt::opt::benchmarks {
 
 class Cantilever : public opt::Problem {
  public:
@@ -20,4 +20,4 @@ class Cantilever : public opt::Problem {
   std::optional<opt::BestKnown> best_known() const override;
 };
 
-}  // namespace abuopt::problems
+}  // namespace abuopt::opt::benchmarks

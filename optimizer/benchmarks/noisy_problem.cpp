@@ -1,11 +1,11 @@
-#include "abuopt/problems/benchmarks/noisy_problem.hpp"
+#include "abuopt/optimizer/benchmarks/noisy_problem.hpp"
 
 #include <cmath>
 #include <cstring>
 
 #include "abuopt/common/config_error.hpp"
 
-namespace abuopt::problems {
+namespace abuopt::opt::benchmarks {
 
 namespace {
 std::uint64_t splitmix64(std::uint64_t z) {
@@ -44,4 +44,4 @@ opt::Evaluation NoisyProblem::evaluate(const std::vector<double>& x) {
   return e;
 }
 
-}  // namespace abuopt::problems
+}  // namespace abuopt::opt::benchmarks

@@ -8,7 +8,7 @@
 
 #include "abuopt/optimizer/problem.hpp"
 
-namespace abuopt::problems {
+namespace abuopt::opt::benchmarks {
 
 struct BenchmarkSettings {
   int dimension = 2;              // Rosenbrock only (2..10); the others have a fixed size
@@ -20,4 +20,4 @@ std::vector<std::string> benchmark_names();
 // Throws abuopt::ConfigError for an unknown name, listing the valid ones.
 std::unique_ptr<opt::Problem> make_benchmark(const std::string& name, const BenchmarkSettings& settings = {});
 
-}  // namespace abuopt::problems
+}  // namespace abuopt::opt::benchmarks

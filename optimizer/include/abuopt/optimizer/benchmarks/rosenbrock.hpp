@@ -5,7 +5,7 @@
 // x = (-1, 1, ..., 1). Bounds [-bound, bound] (default 2); start (-1.2, 1, -1.2, 1, ...).
 #include "abuopt/optimizer/problem.hpp"
 
-namespace abuopt::problems {
+namespace abuopt::opt::benchmarks {
 
 class Rosenbrock : public opt::Problem {
  public:
@@ -24,4 +24,4 @@ class Rosenbrock : public opt::Problem {
   double bound_;
 };
 
-}  // namespace abuopt::problems
+}  // namespace abuopt::opt::benchmarks

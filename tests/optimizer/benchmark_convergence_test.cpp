@@ -8,7 +8,7 @@
 #include <string>
 
 #include "abuopt/optimizer/minimize.hpp"
-#include "abuopt/problems/benchmarks/benchmark_factory.hpp"
+#include "abuopt/optimizer/benchmarks/benchmark_factory.hpp"
 
 namespace {
 
@@ -47,10 +47,10 @@ class BenchmarkConvergence : public testing::TestWithParam<Case> {};
 
 TEST_P(BenchmarkConvergence, ReachesBestKnown) {
   const Case& c = GetParam();
-  problems::BenchmarkSettings s;
+  opt::benchmarks::BenchmarkSettings s;
   s.dimension = c.dimension;
   s.noise_amplitude = c.noise;
-  auto problem = problems::make_benchmark(c.problem, s);
+  auto problem = opt::benchmarks::make_benchmark(c.problem, s);
   const opt::BestKnown best = *problem->best_known();
 
   opt::OptimizerOptions o;
