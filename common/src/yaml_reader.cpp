@@ -187,6 +187,39 @@ std::vector<double> YamlReader::get_double_list(const std::string& key, const Ru
   return out;
 }
 
+std::vector<std::string> YamlReader::get_string_list_or(const std::string& key, const std::vector<std::string>& fallback) {
+  YAML::Node n = at(key);
+  if (!n) return fallback;
+  std::vector<std::string> out;
+  if (n.IsScalar()) {
+    out.push_back(n.Scalar());
+    return out;
+  }
+  if (!n.IsSequence()) throw ConfigError(key_path(key), yaml_value_text(n), "must be a string or a list of strings");
+  for (size_t i = 0; i < n.size(); ++i) {
+    if (!n[i].IsScalar())
+      throw ConfigError(key_path(key) + "[" + std::to_string(i) + "]", yaml_value_text(n[i]), "must be a string");
+    out.push_back(n[i].Scalar());
+  }
+  return out;
+}
+
+YAML::Node merge_yaml(const YAML::Node& base, const YAML::Node& overlay) {
+  if (!overlay || overlay.IsNull()) return YAML::Clone(base);
+  if (!base || !base.IsMap() || !overlay.IsMap()) return YAML::Clone(overlay);
+  YAML::Node out = YAML::Clone(base);
+  for (auto it = overlay.begin(); it != overlay.end(); ++it) {
+    const std::string key = it->first.Scalar();
+    const YAML::Node& cout_ = out;  // const lookup: does not insert
+    const YAML::Node existing = cout_[key];
+    if (existing && existing.IsMap() && it->second.IsMap())
+      out[key] = merge_yaml(existing, it->second);
+    else
+      out[key] = YAML::Clone(it->second);
+  }
+  return out;
+}
+
 YamlReader YamlReader::child(const std::string& key) { return YamlReader(at(key), key_path(key)); }
 
 bool YamlReader::is_sequence(const std::string& key) const { return has(key) && static_cast<const YAML::Node&>(node_)[key].IsSequence(); }

@@ -1,7 +1,8 @@
 // Event-driven simulation of one ABU startup (see simulator.hpp and docs/model.md).
 //
-// Integration runs in non-dimensional time tbar = omega_n t with SUNDIALS ARKODE (explicit
-// ERKStep, a high-order table) in one-step mode. Each ball owns two root functions:
+// Integration runs in non-dimensional time tbar = omega_n t, one step at a time, with the native
+// explicit Runge-Kutta stepper (default; ARKODE's Fehlberg 7(8) table) or SUNDIALS ARKODE's
+// ERKStep (the reference). Each ball owns two root functions:
 //   slipping ball:  g_a = sigma_i beta_i'             (slip -> stick candidate when it reaches 0)
 //                   g_b = 1                            (unused)
 //   stuck ball:     g_a = mu fn_i - fw_i + off_a       (stick -> slip forward)
@@ -41,6 +42,7 @@ std::string to_string(RunStatus s) {
     case RunStatus::SolverFailure: return "solver_failure";
     case RunStatus::ChatterLimit: return "chatter_limit";
     case RunStatus::StepLimit: return "step_limit";
+    case RunStatus::EventLimit: return "event_limit";
   }
   return "unknown";
 }
@@ -204,8 +206,8 @@ bool Run::handle_event(double t) {
     return false;
   }
   if (out_.events > rs_.opt.max_events) {
-    out_.status = RunStatus::ChatterLimit;
-    out_.message = "more than " + std::to_string(rs_.opt.max_events) + " stick/slip events";
+    out_.status = RunStatus::EventLimit;
+    out_.message = "more than " + std::to_string(rs_.opt.max_events) + " events in all (simulation.max_events)";
     return false;
   }
   track_all_stuck(t);
@@ -307,9 +309,9 @@ RunOutcome Run::finish(const Integrator& integ) {
 RunOutcome Simulator::run(const std::vector<double>& beta0, const RunOverrides& ov,
                           std::vector<TrajectoryPoint>* trajectory) const {
   const auto wall0 = std::chrono::steady_clock::now();
-  if (beta0.size() != setup_.abu.balls.size())
-    throw ConfigError("the ABU has " + std::to_string(setup_.abu.balls.size()) + " balls, but " +
-                      std::to_string(beta0.size()) + " initial angles were given");
+  if (beta0.size() != setup_.abu.balls.size())  // API misuse: the caller sizes beta0 from ball_count()
+    throw std::invalid_argument("Simulator::run: the ABU has " + std::to_string(setup_.abu.balls.size()) +
+                                " balls, but " + std::to_string(beta0.size()) + " initial angles were given");
   Run run(setup_, end_time_s(), beta0, ov, trajectory);
   RunOutcome out = run.execute();
   out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
