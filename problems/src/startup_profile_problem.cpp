@@ -41,6 +41,11 @@ DesignValue read_design_value(YamlReader& seg, const std::string& key, std::opti
     return v;
   }
   const YAML::Node& n = seg.node();
+  if (key == "end_frequency_hz" && n[key].IsScalar() && n[key].Scalar() == "hold") {
+    v.hold = true;
+    seg.get_string(key);  // marks the key as used
+    return v;
+  }
   if (n[key].IsMap()) {
     YamlReader m = seg.child(key);
     v.free = true;
@@ -88,7 +93,9 @@ InitialConditionKind kind_of(const std::string& s, const std::string& path) {
 }
 
 void append_value(std::ostringstream& os, const std::string& name, const DesignValue& v) {
-  if (v.free)
+  if (v.hold)
+    os << "  " << name << ": hold\n";
+  else if (v.free)
     os << "  " << name << ": free\n";
   else
     os << "  " << name << ": " << format_number(v.value) << "\n";
@@ -127,6 +134,15 @@ std::string to_string(ObjectiveKind k) {
 }
 std::string to_string(ImbalanceDefinition d) { return d == ImbalanceDefinition::magnitude ? "magnitude" : "report_x"; }
 std::string to_string(AmplitudeStatistic a) { return a == AmplitudeStatistic::max ? "max" : "mean"; }
+
+double peak_angular_acceleration_rad_s2(const StartupProfile& profile) {
+  double peak = 0, f0 = profile.start_frequency_hz();
+  for (const auto& g : profile.segments()) {
+    peak = std::max(peak, 2 * M_PI * 2 * std::abs(g.end_frequency_hz - f0) / g.duration_s);
+    f0 = g.end_frequency_hz;
+  }
+  return peak;
+}
 
 std::uint64_t fnv1a64(std::string_view text) {
   std::uint64_t h = 14695981039346656037ull;
@@ -206,6 +222,8 @@ StartupProfileSettings read_startup_profile_settings(YamlReader& root) {
   if (c.has("max_startup_time_s")) s.constraints.max_startup_time_s = c.get_double("max_startup_time_s", Rule::positive());
   if (c.has("max_amplitude_mm")) s.constraints.max_amplitude_mm = c.get_double("max_amplitude_mm", Rule::positive());
   if (c.has("max_pct_mi")) s.constraints.max_pct_mi = c.get_double("max_pct_mi", Rule::in_range(1e-9, 100.0));
+  if (c.has("max_angular_acceleration_rad_s2"))
+    s.constraints.max_angular_acceleration_rad_s2 = c.get_double("max_angular_acceleration_rad_s2", Rule::positive());
   s.constraints.amplitude =
       c.get_choice_or("amplitude", "max", {"max", "mean"}) == "max" ? AmplitudeStatistic::max : AmplitudeStatistic::mean;
   s.constraints.penalty_weight = c.get_double_or("penalty_weight", 0.0, Rule::non_negative());
@@ -243,7 +261,10 @@ void validate(const StartupProfileSettings& s) {
     throw ConfigError("design.start_frequency_hz", format_number(d.start_frequency_hz), "must be >= 0");
   std::size_t free = 0;
   for (std::size_t i = 0; i < d.segments.size(); ++i) {
-    check_value(d.segments[i].end_frequency_hz, segment_path(i) + ".end_frequency_hz", false);
+    if (d.segments[i].end_frequency_hz.hold && d.segments[i].end_frequency_hz.free)
+      throw ConfigError(segment_path(i) + ".end_frequency_hz", "hold", "a hold segment has no free end frequency");
+    if (!d.segments[i].end_frequency_hz.hold)
+      check_value(d.segments[i].end_frequency_hz, segment_path(i) + ".end_frequency_hz", false);
     check_value(d.segments[i].duration_s, segment_path(i) + ".duration_s", true);
     free += d.segments[i].end_frequency_hz.free + d.segments[i].duration_s.free;
   }
@@ -269,6 +290,7 @@ void validate(const StartupProfileSettings& s) {
   positive(c.max_startup_time_s, "constraints.max_startup_time_s");
   positive(c.max_amplitude_mm, "constraints.max_amplitude_mm");
   positive(c.max_pct_mi, "constraints.max_pct_mi");
+  positive(c.max_angular_acceleration_rad_s2, "constraints.max_angular_acceleration_rad_s2");
   if (!(std::isfinite(c.penalty_weight) && c.penalty_weight >= 0))
     throw ConfigError("constraints.penalty_weight", format_number(c.penalty_weight), "must be >= 0");
   if (s.validation.runs < 1) throw ConfigError("validation.runs", "0", "must be >= 1");
@@ -298,6 +320,7 @@ StartupProfileProblem::StartupProfileProblem(StartupProfileSettings settings) : 
   if (c.max_startup_time_s) constraint_names_.push_back("startup_time");
   if (c.max_amplitude_mm) constraint_names_.push_back("amplitude");
   if (c.max_pct_mi) constraint_names_.push_back("pct_mi");
+  if (c.max_angular_acceleration_rad_s2) constraint_names_.push_back("angular_acceleration");
 }
 
 std::vector<std::string> StartupProfileProblem::inequality_names() const {
@@ -317,6 +340,10 @@ StartupProfile StartupProfileProblem::profile_at(const std::vector<double>& x) c
     InclinedSineSegment& g = segs[slots_[k].segment];
     (slots_[k].duration ? g.duration_s : g.end_frequency_hz) = x[k];
   }
+  // Holds take the previous end frequency (the start frequency for the first segment).
+  for (std::size_t i = 0; i < segs.size(); ++i)
+    if (settings_.design.segments[i].end_frequency_hz.hold)
+      segs[i].end_frequency_hz = i == 0 ? settings_.design.start_frequency_hz : segs[i - 1].end_frequency_hz;
   return StartupProfile(std::move(segs), settings_.design.start_frequency_hz);
 }
 
@@ -433,6 +460,7 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
   m["runs"] = static_cast<double>(all.runs);
   m["failed_runs"] = static_cast<double>(all.failed);
   m["mc_wall_time_s"] = wall;
+  m["peak_angular_acceleration_rad_s2"] = peak_angular_acceleration_rad_s2(profile);
   if (passes.size() > 1 || passes.front()) {
     for (std::size_t k = 0; k < passes.size(); ++k) {
       const std::string tag = std::to_string(k + 1);
@@ -462,6 +490,8 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
     g.push_back(a / *c.max_amplitude_mm - 1.0);
   }
   if (c.max_pct_mi) g.push_back(ir(all).pct_mi / *c.max_pct_mi - 1.0);
+  if (c.max_angular_acceleration_rad_s2)
+    g.push_back(peak_angular_acceleration_rad_s2(profile) / *c.max_angular_acceleration_rad_s2 - 1.0);
   if (c.penalty_weight > 0) {
     m["objective_without_penalty"] = e.objective;
     double pen = 0;
@@ -505,8 +535,11 @@ std::string StartupProfileProblem::identity_text() const {
   auto opt_text = [](const std::optional<double>& v) { return v ? format_number(*v) : std::string("none"); };
   os << "constraints: {max_startup_time_s: " << opt_text(c.max_startup_time_s)
      << ", max_amplitude_mm: " << opt_text(c.max_amplitude_mm) << ", amplitude: " << to_string(c.amplitude)
-     << ", max_pct_mi: " << opt_text(c.max_pct_mi) << ", penalty_weight: " << format_number(c.penalty_weight)
-     << "}\n";
+     << ", max_pct_mi: " << opt_text(c.max_pct_mi) << ", penalty_weight: " << format_number(c.penalty_weight);
+  // Only when set, so that the identity (archive key) of every earlier config is unchanged.
+  if (c.max_angular_acceleration_rad_s2)
+    os << ", max_angular_acceleration_rad_s2: " << format_number(*c.max_angular_acceleration_rad_s2);
+  os << "}\n";
   return os.str();
 }
 

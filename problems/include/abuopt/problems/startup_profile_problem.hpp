@@ -26,6 +26,7 @@
 //   amplitude:     A / max_amplitude_mm - 1 <= 0, A = max over runs of the peak amplitude
 //                  (amplitude: max, default) or the mean over runs of it (amplitude: mean)
 //   pct_mi:        %MI / max_pct_mi - 1 <= 0                    (definition of the objective)
+//   angular_acceleration: a / max_angular_acceleration_rad_s2 - 1 <= 0, a = peak_angular_acceleration()
 // With constraints.penalty_weight = w > 0 the problem declares NO constraints (for bound-only
 // optimisers) and minimises objective + w * sum_i max(0, g_i) instead (exact L1 penalty).
 //
@@ -57,6 +58,7 @@ namespace abuopt::problems {
 // One value of a segment: fixed, or a free design variable with bounds.
 struct DesignValue {
   bool free = false;
+  bool hold = false;    // end frequency only: equal to the previous segment's end (a dwell), no variable
   double value = 0.0;   // fixed: the value; free: the starting point x0
   double lower = 0.0;   // free only
   double upper = 0.0;   // free only
@@ -97,6 +99,9 @@ struct ConstraintSettings {
   std::optional<double> max_amplitude_mm;
   AmplitudeStatistic amplitude = AmplitudeStatistic::max;
   std::optional<double> max_pct_mi;
+  // Peak angular acceleration of the profile, max over segments of 2 pi * 2 |H| / dt [rad/s^2]
+  // (exact, no noise): what the drive must be able to follow.
+  std::optional<double> max_angular_acceleration_rad_s2;
   double penalty_weight = 0.0;  // > 0: constraints folded into the objective (no declared constraints)
 };
 
@@ -131,6 +136,10 @@ ProfileDesign read_profile_design(YamlReader design, const StartupProfile& profi
 // Throws ConfigError for an invalid design (no free variable, bounds reversed, x0 outside the
 // bounds, durations not > 0, ...), objective or constraint settings.
 void validate(const StartupProfileSettings& s);
+
+// Peak angular acceleration of a profile [rad/s^2]: an inclined sine of height H and duration dt
+// peaks at f' = 2 |H| / dt (at its middle), so a = max over segments of 2 pi * 2 |H| / dt.
+double peak_angular_acceleration_rad_s2(const StartupProfile& profile);
 
 // FNV-1a, 64 bits.
 std::uint64_t fnv1a64(std::string_view text);
