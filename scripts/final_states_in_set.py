@@ -88,6 +88,17 @@ def main():
     print(f"final |I_r| / r_in(f at settling): p10 {q(ratio, 0.1):.3f}  median {q(ratio, 0.5):.3f}  "
           f"p90 {q(ratio, 0.9):.3f}")
     print(f"runs with final |I_r| < r_lock (in the set at every speed): {sum(u < r_lock for u in ir) / n * 100:.1f} %")
+    # Pair separation: a run whose balls end s apart cannot leave less than |m_I e - 2 m L cos(s/2)|.
+    def sep(r):
+        d = (float(r["beta_final_1"]) - float(r["beta_final_2"])) % (2 * math.pi)
+        return min(d, 2 * math.pi - d)
+
+    seps = [sep(r) for r in rows]
+    goal = 7.0e-7
+    s_goal = 2 * math.acos((MI * E + goal) / (2 * M_BALL * L))  # smallest separation allowing |I_r| <= goal
+    print(f"ball separation at the end [rad]: p10 {q(seps, 0.1):.3f}  median {q(seps, 0.5):.3f}  p90 {q(seps, 0.9):.3f}; "
+          f"closer than a ball diameter (0.262): {sum(x < 0.262 for x in seps) / n * 100:.1f} %; "
+          f"at least {s_goal:.3f} (needed for |I_r| <= 7e-7): {sum(x >= s_goal for x in seps) / n * 100:.1f} %")
     print(f"runs whose final state is in the set at f(settling): {inside / n * 100:.1f} %; "
           f"at every frequency from there to 100 Hz (0.05 Hz steps): {inside_all / n * 100:.1f} %")
 

@@ -75,6 +75,15 @@ double locked_residual_kgm(const EquilibriumSet& set) {
   return mass_length(set.parameters()) * mu / ((1 + mu) * max_gain);
 }
 
+double pair_separation_floor_kgm(const AbuParameters& p, double separation_rad) {
+  if (p.balls.size() != 2)
+    throw std::invalid_argument("pair_separation_floor_kgm: needs exactly 2 balls, the ABU has " +
+                                std::to_string(p.balls.size()));
+  const double L = p.ball_track_radius_m;
+  const double pair = L * std::abs(p.balls[0].mass_kg + p.balls[1].mass_kg * std::polar(1.0, separation_rad));
+  return std::abs(p.imbalance_kgm() - pair);
+}
+
 std::vector<std::pair<double, double>> balancing_angles(const AbuParameters& p, const std::vector<double>& other_beta) {
   const std::size_t nb = p.balls.size();
   if (nb < 2 || other_beta.size() != nb - 2)

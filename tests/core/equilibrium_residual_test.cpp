@@ -177,3 +177,29 @@ TEST(EquilibriumResidual, NearResonanceTheSetAllowsLessImbalance) {
   EXPECT_THROW(abuopt::equilibrium_residual_scan(set, 30, 28, 0.5, 32), std::invalid_argument);
   EXPECT_THROW(abuopt::inscribed_residual_kgm(set, 0), std::invalid_argument);
 }
+
+// Two equal balls s apart leave at least |m_I e - 2 m L cos(s/2)|: 11.48e-7 kg m when they sit
+// together (s = 0), 0 at the balancing separation 2 (pi - beta*) = 1.7435 rad; brute force over the
+// pair's orientation never goes below the bound and reaches it within 1e-3 of the orientation grid.
+TEST(EquilibriumResidual, PairSeparationFloor) {
+  const AbuParameters p;
+  const double mL = p.balls[0].mass_kg * p.ball_track_radius_m;
+  EXPECT_NEAR(abuopt::pair_separation_floor_kgm(p, 0) / 1e-7, 11.48, 1e-9);
+  const double s_bal = 2 * (M_PI - report_balancing_angle(p));
+  EXPECT_NEAR(s_bal, 1.7435, 1e-4);
+  EXPECT_NEAR(abuopt::pair_separation_floor_kgm(p, s_bal), 0, 1e-18);
+  for (double s : {0.0, 0.262, 0.5, 1.0, 1.06, 1.5, 2.5, M_PI}) {
+    const double bound = abuopt::pair_separation_floor_kgm(p, s);
+    EXPECT_NEAR(bound, std::abs(p.imbalance_kgm() - 2 * mL * std::cos(s / 2)), 1e-18) << s;
+    double best = INFINITY;
+    for (int k = 0; k < 20000; ++k) {
+      const double th = 2 * M_PI * k / 20000;
+      best = std::min(best, magnitude(p, {th, th + s}));
+    }
+    EXPECT_GE(best, bound * (1 - 1e-12)) << s;
+    EXPECT_LT(best - bound, 1e-3 * 2 * mL) << s;
+  }
+  AbuParameters three;
+  three.balls = {Ball{}, Ball{}, Ball{}};
+  EXPECT_THROW(abuopt::pair_separation_floor_kgm(three, 0), std::invalid_argument);
+}

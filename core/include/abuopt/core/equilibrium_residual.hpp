@@ -55,6 +55,14 @@ std::pair<double, double> residual_vector_kgm(const AbuParameters& p, const std:
 double inscribed_residual_kgm(const EquilibriumSet& set, double frequency_hz);
 double locked_residual_kgm(const EquilibriumSet& set);
 
+// Two balls of masses m_1, m_2 a (wrapped) angle s apart: U = m_I e + L (m_1 e^{i b_1} + m_2 e^{i b_2}),
+// and the ball pair's vector has length L |m_1 + m_2 e^{i s}| whatever its orientation, so
+//   |I_r| >= | m_I e - L |m_1 + m_2 e^{i s}| |   (= |m_I e - 2 m L cos(s/2)| for equal balls),
+// with equality when the pair points away from the imbalance. No orientation does better: a run whose
+// balls end s apart cannot end below this, which bounds what balls that travel together can reach.
+// Needs exactly two balls (std::invalid_argument otherwise).
+double pair_separation_floor_kgm(const AbuParameters& p, double separation_rad);
+
 // The balancing configurations in the (beta_1, beta_2) plane with balls 3..N at other_beta: the
 // (0, 1 or 2) solutions of U = 0, each {beta_1, beta_2} in [0, 2 pi).
 std::vector<std::pair<double, double>> balancing_angles(const AbuParameters& p,
