@@ -32,7 +32,7 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/optimizer/benchmarking.hpp"
-#include "abuopt/problems/benchmarks/benchmark_factory.hpp"
+#include "abuopt/optimizer/benchmarks/benchmark_factory.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
 #include "commands/commands.hpp"
 
@@ -65,7 +65,7 @@ opt::ProblemSpec read_startup_profile_problem(YamlReader& r) {
   section.finish();
   problems::StartupProfileProblem check(settings);  // a bad design is a ConfigError now, before any run
   spec.label = r.get_string_or("label", "startup_profile");
-  spec.make = [settings] { return std::make_unique<problems::StartupProfileProblem>(settings); };
+  spec.make = [settings] { return problems::make_startup_profile_problem(settings); };
   read_run_settings(r, spec);
   r.finish();
   return spec;
@@ -79,16 +79,16 @@ opt::ProblemSpec read_problem(YamlReader& r) {
   }
   opt::ProblemSpec spec;
   const std::string name = r.get_string("benchmark");
-  problems::BenchmarkSettings settings;
+  opt::benchmarks::BenchmarkSettings settings;
   settings.dimension = static_cast<int>(r.get_int_or("dimension", settings.dimension, Rule::in_range(2, 10)));
   settings.noise_amplitude = r.get_double_or("noise_amplitude", settings.noise_amplitude, Rule::in_range(0, 0.999));
   settings.noise_seed =
       static_cast<std::uint64_t>(r.get_int_or("noise_seed", static_cast<long>(settings.noise_seed), Rule::non_negative()));
-  problems::make_benchmark(name, settings);  // an unknown name is a ConfigError now, listing the valid ones
+  opt::benchmarks::make_benchmark(name, settings);  // an unknown name is a ConfigError now, listing the valid ones
   spec.label = r.get_string_or("label", name == "rosenbrock" || name == "noisy_rosenbrock"
                                             ? name + std::to_string(settings.dimension)
                                             : name);
-  spec.make = [name, settings] { return problems::make_benchmark(name, settings); };
+  spec.make = [name, settings] { return opt::benchmarks::make_benchmark(name, settings); };
   read_run_settings(r, spec);
   r.finish();
   return spec;

@@ -22,7 +22,9 @@
 #include "abuopt/optimizer/evaluation_archive.hpp"
 #include "abuopt/optimizer/minimize.hpp"
 #include "abuopt/optimizer/optimizer_options.hpp"
+#include "abuopt/optimizer/penalty_problem.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
+#include "abuopt/studies/out_of_sample.hpp"
 #include "commands/commands.hpp"
 
 namespace abuopt::app {
@@ -183,48 +185,16 @@ void write_best_profile(const fs::path& path, const StartupProfileProblem& probl
     << to_yaml(setup);
 }
 
-struct Row {
-  std::string label;
-  opt::Evaluation e;
-};
-
-std::string metric_cell(const opt::Evaluation& e, const std::string& key, int width, int precision = 3) {
-  std::ostringstream os;
-  auto it = e.metrics.find(key);
-  if (it == e.metrics.end() || !std::isfinite(it->second))
-    os << std::setw(width) << "-";
-  else
-    os << std::setw(width) << std::fixed << std::setprecision(precision) << it->second;
-  return os.str();
-}
-
-std::string comparison_table(const std::vector<Row>& rows) {
-  std::ostringstream os;
-  os << std::left << std::setw(34) << "  design, sample" << std::right << std::setw(10) << "objective" << std::setw(10)
-     << "mean|Ir|" << std::setw(10) << "mean Irx" << std::setw(9) << "%MI|Ir|" << std::setw(8) << "%MI Irx"
-     << std::setw(7) << "%LC" << std::setw(9) << "amp[mm]" << std::setw(8) << "T[s]" << std::setw(7) << "failed"
-     << "\n";
-  for (const auto& r : rows) {
-    os << std::left << std::setw(34) << ("  " + r.label) << std::right;
-    if (std::isfinite(r.e.objective))
-      os << std::setw(10) << std::fixed << std::setprecision(4) << r.e.objective;
-    else
-      os << std::setw(10) << "failed";
-    os << metric_cell(r.e, "ir_magnitude_mean", 10) << metric_cell(r.e, "ir_x_mean", 10)
-       << metric_cell(r.e, "pct_mi_magnitude", 9, 2) << metric_cell(r.e, "pct_mi_x", 8, 2)
-       << metric_cell(r.e, "pct_lc", 7, 2) << metric_cell(r.e, "amplitude_max_mm", 9) << metric_cell(r.e, "startup_time_s", 8, 2)
-       << metric_cell(r.e, "failed_runs", 7, 0) << "\n";
-  }
-  os << "  (I_r in 1e-7 kg m; amp = max over runs of the peak amplitude; T = startup time)\n";
-  return os.str();
-}
-
 int run_optimize(const OptimizeArgs& a) {
   LoadedConfig cfg = load_config(a);
   StartupProfileProblem problem(cfg.settings);
   const auto& st = problem.settings();
+  // What the optimiser sees: the problem, or its penalty form (constraints.penalty_weight > 0).
+  std::optional<opt::PenaltyProblem> penalised;
+  if (st.constraints.penalty_weight > 0) penalised.emplace(problem, st.constraints.penalty_weight);
+  opt::Problem& optimised = penalised ? static_cast<opt::Problem&>(*penalised) : problem;
   const std::vector<opt::Variable> vars = problem.variables();
-  const std::vector<std::string> g_names = problem.inequality_names();
+  const std::vector<std::string> g_names = optimised.inequality_names();
 
   const fs::path out = a.out.empty() ? fs::path("results") / fs::path(a.config).stem() : fs::path(a.out);
   std::error_code ec;
@@ -232,7 +202,7 @@ int run_optimize(const OptimizeArgs& a) {
   if (ec) throw ConfigError("--out", out.string(), "cannot be created (" + ec.message() + ")");
   const std::string id = problem.identity();
   opt::EvaluationArchive archive((out / "archive.sqlite").string(), id);
-  opt::ArchivedProblem archived(problem, archive);
+  opt::ArchivedProblem archived(optimised, archive);
   cfg.options.sao.archive = &archive;  // SAO: archived points inform its surrogates
 
   // Progress to stdout, or to stderr with --json (stdout then holds the JSON alone).
@@ -347,23 +317,15 @@ int run_optimize(const OptimizeArgs& a) {
   auto write_json = [&] { open_out(result_json) << j.dump(2) << "\n"; };
   write_json();
 
-  const bool interrupted = r.reason == opt::TerminationReason::interrupted;
+  const bool interrupted = r.reason == opt::TerminationReason::Interrupted;
   if (have_best && st.validation.enabled && !interrupted) {
     const auto& v = st.validation;
     log << "\nvalidation: " << v.runs << " fresh initial conditions (" << to_string(v.design) << ", seed " << v.seed
         << ") for the best design and for the report's final profile ...\n"
         << std::flush;
-    const StartupProfile best = problem.profile_at(r.x), report = StartupProfile::report_final();
-    opt::Evaluation best_in;
-    best_in.objective = r.objective;
-    best_in.inequality = r.inequality;
-    best_in.metrics = r.metrics;
-    const std::vector<Row> rows = {
-        {"best, in-sample (" + std::to_string(st.study.runs) + ")", best_in},
-        {"best, out-of-sample (" + std::to_string(v.runs) + ")", problem.evaluate_out_of_sample(best)},
-        {"report profile, in-sample", problem.evaluate_profile(report)},
-        {"report profile, out-of-sample", problem.evaluate_out_of_sample(report)},
-    };
+    const OutOfSampleComparison cmp = compare_out_of_sample(problem, r, penalised ? &*penalised : nullptr);
+    const StartupProfile& report = cmp.report;
+    const std::vector<ComparisonRow>& rows = cmp.rows;
     log << comparison_table(rows);
     log << "  report profile: " << profile_text(report) << "\n";
     j["validation"] = {{"runs", v.runs},

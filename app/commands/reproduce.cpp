@@ -1,6 +1,6 @@
 // abuopt reproduce: runs the 2003 report's studies (configs/report/*.yaml) and prints every table
 // side by side with the published values, plus a verdict per published conclusion. The work is in
-// core/reproduction.hpp; this file parses options, finds the study files and prints.
+// studies/reproduction.hpp; this file parses options, finds the study files and prints.
 #include <unistd.h>
 
 #include <chrono>
@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "abuopt/common/config_error.hpp"
-#include "abuopt/core/reproduction.hpp"
+#include "abuopt/studies/reproduction.hpp"
 #include "commands/commands.hpp"
 
 namespace abuopt::app {
@@ -76,14 +76,14 @@ int run_reproduce(const ReproduceArgs& a) {
   if (a.runs && *a.runs < 1) throw ConfigError("--runs", std::to_string(*a.runs), "must be >= 1");
 
   const std::string dir = find_configs(a.configs);
-  std::vector<ReproductionTable> tables = select_tables(read_reproduction_tables(dir), a.only);
+  std::vector<ReproductionTable> tables = select_tables(read_reproduction_tables(dir), a.only, "--only");
 
   ReproductionOptions opt;
   opt.out_dir = a.out.empty() ? default_out_dir() : a.out;
   opt.threads = a.threads ? static_cast<std::size_t>(*a.threads) : 0;
   opt.plots = !a.no_plots;
   opt.command_line = command_line(a, opt.out_dir);
-  if (a.runs) opt.runs_note = override_runs(tables, static_cast<std::size_t>(*a.runs));
+  if (a.runs) opt.runs_note = override_runs(tables, static_cast<std::size_t>(*a.runs), "--runs");
   opt.log = [](const std::string& line) { std::cerr << line << std::endl; };
 
   std::size_t cases = 0, runs = 0;

@@ -25,7 +25,7 @@ NondimParameters NondimParameters::from(const AbuParameters& p) {
 void AbuModel::evaluate(const double* y, double W, double Wp, const BallMode* modes, double mu,
                         ModelForces& out) const {
   const std::size_t n = layout_.n_balls;
-  const double x = y[0], yy = y[1], xd = y[2], yd = y[3];
+  const double x = y[StateLayout::x], yy = y[StateLayout::y], xd = y[StateLayout::x_dot], yd = y[StateLayout::y_dot];
   const double W2 = W * W;
   const double bb = nd_.bbar;
   constexpr double J = NondimParameters::Jbar;
@@ -38,11 +38,12 @@ void AbuModel::evaluate(const double* y, double W, double Wp, const BallMode* mo
   //           = [-h_x + sum m s r; -h_y - sum m c r].
   double A11 = 1, A12 = 0, A21 = 0, A22 = 1, R1 = 0, R2 = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    const double bdi = y[4 + n + i];
-    if (y[4 + i] != out.sc_beta[i]) {
-      out.s[i] = std::sin(y[4 + i]);
-      out.c[i] = std::cos(y[4 + i]);
-      out.sc_beta[i] = y[4 + i];
+    const double bdi = y[layout_.beta_dot(i)];
+    const double beta = y[layout_.beta(i)];
+    if (beta != out.sc_beta[i]) {
+      out.s[i] = std::sin(beta);
+      out.c[i] = std::cos(beta);
+      out.sc_beta[i] = beta;
     }
     const double s = out.s[i], c = out.c[i];
     const double m = nd_.mbar[i];
@@ -83,7 +84,7 @@ void AbuModel::evaluate(const double* y, double W, double Wp, const BallMode* mo
     out.fn[i] = fn;
     if (modes[i] == BallMode::Stick) {
       out.betadd[i] = 0.0;
-      out.fw[i] = -(-s * a + c * b + out.hb[i] + nd_.cbar[i] * y[4 + n + i]);
+      out.fw[i] = -(-s * a + c * b + out.hb[i] + nd_.cbar[i] * y[layout_.beta_dot(i)]);
     } else {
       const double ms = mu * static_cast<double>(static_cast<signed char>(modes[i]));
       out.betadd[i] = out.r[i] + ((s + ms * c) * a - (c - ms * s) * b) / nd_.D[i];
@@ -97,7 +98,7 @@ bool AbuModel::choose_modes(const double* y, double W, double Wp, double mu, dou
   const std::size_t n = layout_.n_balls;
   std::vector<std::size_t> free_balls;  // balls at (numerically) zero relative speed
   for (std::size_t i = 0; i < n; ++i) {
-    const double v = y[4 + n + i];
+    const double v = y[layout_.beta_dot(i)];
     if (fixed && (*fixed)[i]) continue;
     if (std::fabs(v) <= vtol) {
       free_balls.push_back(i);

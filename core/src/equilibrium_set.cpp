@@ -82,10 +82,11 @@ bool EquilibriumSet::evaluate_point(double W, const double* beta, std::vector<do
   }
   const double xs = W2 * (a * Cx + b * Cy) / det, ys = W2 * (a * Cy - b * Cx) / det;
   amp_mm = std::hypot(xs, ys) * nd_.length_m * 1e3;
-  state.assign(4 + 2 * n, 0.0);
-  state[0] = xs;
-  state[1] = ys;
-  for (std::size_t i = 0; i < n; ++i) state[4 + i] = beta[i];
+  const StateLayout& lay = model_.layout();
+  state.assign(lay.size(), 0.0);
+  state[StateLayout::x] = xs;
+  state[StateLayout::y] = ys;
+  for (std::size_t i = 0; i < n; ++i) state[lay.beta(i)] = beta[i];
   static thread_local std::vector<BallMode> modes;
   modes.assign(n, BallMode::Stick);
   model_.evaluate(state.data(), W, 0.0, modes.data(), mu_, f);

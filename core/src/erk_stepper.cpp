@@ -119,11 +119,20 @@ double ErkStepper::attempt(double t0, const double* y0, const double* f0, double
   return std::sqrt(norm / static_cast<double>(n_));
 }
 
+namespace {
+bool all_finite(const std::vector<double>& v) {
+  for (double x : v)
+    if (!std::isfinite(x)) return false;
+  return true;
+}
+}  // namespace
+
 ErkStepper::Status ErkStepper::step() {
   const int q = std::min(tab_.order, tab_.embedded_order);
   const double expo = 1.0 / (q + 1);
   if (t_ >= tstop_) return StopReached;
   if (steps_ >= max_steps_) return TooManySteps;
+  if (!std::isfinite(h_) || !std::isfinite(t_) || !all_finite(y_) || !all_finite(f0_)) return NotFinite;
   for (;;) {
     double h = std::min(h_, tstop_ - t_);
     const bool to_stop = h >= tstop_ - t_;
@@ -143,7 +152,8 @@ ErkStepper::Status ErkStepper::step() {
       if (!to_stop || h == h_) h_ = h * std::clamp(fac, 0.2, 5.0);
       break;
     }
-    h_ = h * std::clamp(std::isfinite(fac) ? fac : 0.1, 0.1, 0.9);
+    // a non-finite error estimate (a stage left the domain: NaN or overflow) cuts the step hard
+    h_ = h * (std::isfinite(err) ? std::clamp(std::isfinite(fac) ? fac : 0.1, 0.1, 0.9) : 0.1);
   }
   if (!g_ || nroots_ == 0) return t_ >= tstop_ ? StopReached : Ok;
 

@@ -30,7 +30,9 @@ using RootFn = void (*)(double t, const double* y, double* g, void* user);
 
 class ErkStepper {
  public:
-  enum Status { Ok = 0, Root = 1, StopReached = 2, StepTooSmall = -1, TooManySteps = -2 };
+    // NotFinite: the state, its derivative or the step size is not finite (NaN or inf): the run
+  // cannot continue (a step from such a state would otherwise shrink or repeat forever).
+  enum Status { Ok = 0, Root = 1, StopReached = 2, StepTooSmall = -1, TooManySteps = -2, NotFinite = -3 };
 
   ErkStepper(ButcherTable table, std::size_t n, RhsFn f, RootFn g, std::size_t nroots, void* user, double rtol,
              double atol, long max_steps);

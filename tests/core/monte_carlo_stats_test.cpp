@@ -138,9 +138,10 @@ TEST(MonteCarloStats, QuantileType7) {
 
 TEST(MonteCarloStats, NoOkRunsGivesNaNAndJsonNull) {
   std::vector<MonteCarloSample> runs{sample(0, RunStatus::StepLimit, 1, 1, true, 1, 1),
-                                     sample(1, RunStatus::ChatterLimit, 1, 1, true, 1, 1)};
+                                     sample(1, RunStatus::ChatterLimit, 1, 1, true, 1, 1),
+                                     sample(2, RunStatus::EventLimit, 1, 1, true, 1, 1)};
   const MonteCarloStats s = compute_statistics(runs);
-  EXPECT_EQ(s.failed, 2u);
+  EXPECT_EQ(s.failed, 3u);
   EXPECT_EQ(s.ok, 0u);
   EXPECT_TRUE(std::isnan(s.magnitude.mean));
   EXPECT_TRUE(std::isnan(s.pct_lc));
@@ -149,7 +150,8 @@ TEST(MonteCarloStats, NoOkRunsGivesNaNAndJsonNull) {
   EXPECT_TRUE(j["pct_lc"].is_null());
   EXPECT_EQ(j["status_counts"]["step_limit"], 1);
   EXPECT_EQ(j["status_counts"]["chatter_limit"], 1);
-  EXPECT_FALSE(format_summary(s).empty());
+  EXPECT_EQ(j["status_counts"]["event_limit"], 1);
+  EXPECT_NE(format_summary(s).find("event_limit 1"), std::string::npos) << format_summary(s);
 }
 
 TEST(MonteCarloStats, JsonHasTheDocumentedKeys) {

@@ -243,14 +243,17 @@ TEST(Simulator, FailureIsAnOutcomeNotAnException) {
   EXPECT_FALSE(o.message.empty());
 }
 
-TEST(Simulator, WrongNumberOfAnglesIsAUserError) {
+TEST(Simulator, WrongNumberOfAnglesIsAProgrammingError) {
+  // The caller sizes beta0 from ball_count(); a mismatch is API misuse, not bad configuration.
   const SimulationSetup setup;
   Simulator sim(setup);
   try {
     sim.run({1.0});
     FAIL();
-  } catch (const ConfigError& e) {
-    EXPECT_STREQ(e.what(), "the ABU has 2 balls, but 1 initial angles were given");
+  } catch (const ConfigError&) {
+    FAIL() << "not a configuration error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "Simulator::run: the ABU has 2 balls, but 1 initial angles were given");
   }
 }
 
@@ -298,6 +301,8 @@ TEST(Simulator, ChatterGuardEndsARunAsACountedOutcome) {
   t.options.max_events = 2;
   Simulator sim2(t);
   const RunOutcome o2 = sim2.run({0.1, 0.2});
-  EXPECT_EQ(o2.status, RunStatus::ChatterLimit);
+  EXPECT_EQ(o2.status, RunStatus::EventLimit);  // the total budget, not the chatter guard
   EXPECT_EQ(o2.events, 3);
+  EXPECT_NE(o2.message.find("max_events"), std::string::npos) << o2.message;
+  EXPECT_EQ(to_string(RunStatus::EventLimit), "event_limit");
 }

@@ -9,7 +9,7 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/optimizer/benchmarking.hpp"
-#include "abuopt/problems/benchmarks/benchmark_factory.hpp"
+#include "abuopt/optimizer/benchmarks/benchmark_factory.hpp"
 
 namespace {
 
@@ -105,13 +105,13 @@ TEST(Comparison, RunsEverySolverFromEveryStartAndWritesFiles) {
   opt::ComparisonSetup setup;
   opt::ProblemSpec truss;
   truss.label = "two_bar_truss";
-  truss.make = [] { return problems::make_benchmark("two_bar_truss"); };
+  truss.make = [] { return opt::benchmarks::make_benchmark("two_bar_truss"); };
   truss.max_evaluations = 150;
   truss.starts = 2;
   setup.problems.push_back(truss);
   opt::ProblemSpec rosen;
   rosen.label = "rosenbrock";
-  rosen.make = [] { return problems::make_benchmark("rosenbrock"); };
+  rosen.make = [] { return opt::benchmarks::make_benchmark("rosenbrock"); };
   rosen.max_evaluations = 100;
   setup.problems.push_back(rosen);
   setup.solvers.push_back(opt::solver_spec("SAO", "sao"));
@@ -153,7 +153,7 @@ TEST(Comparison, BadSetupIsAConfigError) {
   EXPECT_THROW(opt::run_comparison(setup), ConfigError);
   opt::ProblemSpec p;
   p.label = "truss";
-  p.make = [] { return problems::make_benchmark("two_bar_truss"); };
+  p.make = [] { return opt::benchmarks::make_benchmark("two_bar_truss"); };
   p.max_evaluations = 0;
   setup.problems.push_back(p);
   setup.solvers.push_back(opt::solver_spec("SAO", "sao"));
@@ -175,10 +175,10 @@ TEST(Comparison, ReadSolverSpec) {
   auto entries = root.children("solvers");
   const opt::SolverSpec a = opt::read_solver_spec(entries[0]);
   EXPECT_EQ(a.label, "SAO-q");
-  EXPECT_EQ(a.options.sao.surrogate, "quadratic");
+  EXPECT_EQ(a.options.sao.surrogate, opt::SurrogateKind::Quadratic);
   const opt::SolverSpec b = opt::read_solver_spec(entries[1]);
   EXPECT_EQ(b.label, "slsqp");
-  EXPECT_EQ(b.options.finite_difference, opt::FiniteDifference::central);
+  EXPECT_EQ(b.options.finite_difference, opt::FiniteDifference::Central);
   try {
     opt::read_solver_spec(entries[2]);
     FAIL() << "no ConfigError";

@@ -7,12 +7,15 @@
 
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <string>
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/core/monte_carlo.hpp"
 #include "abuopt/core/monte_carlo_stats.hpp"
+#include "abuopt/core/simulation_config.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
+#include "../common/perturb_archive.hpp"
 
 namespace {
 
@@ -205,11 +208,14 @@ TEST(StartupProfileProblem, ConstraintValuesAreRelativeToTheirBounds) {
   EXPECT_DOUBLE_EQ(m.inequality[0], m.metrics.at("amplitude_mean_mm") / 2 - 1.0);
   EXPECT_LE(m.metrics.at("amplitude_mean_mm"), m.metrics.at("amplitude_max_mm"));
 
-  // Penalty form: no declared constraints, objective + w * sum max(0, g).
-  StartupProfileProblem pen(
-      settings_from(tiny("{kind: mean}", "{max_startup_time_s: 0.3, max_pct_mi: 40, penalty_weight: 10}")));
-  EXPECT_TRUE(pen.inequality_names().empty());
-  const opt::Evaluation q = pen.evaluate(x);
+  // Penalty form: no declared constraints, objective + w * sum max(0, g); the problem itself keeps
+  // its constraints.
+  const StartupProfileSettings pen_settings =
+      settings_from(tiny("{kind: mean}", "{max_startup_time_s: 0.3, max_pct_mi: 40, penalty_weight: 10}"));
+  EXPECT_EQ(StartupProfileProblem(pen_settings).inequality_names().size(), 2u);
+  const std::unique_ptr<opt::Problem> pen = problems::make_startup_profile_problem(pen_settings);
+  EXPECT_TRUE(pen->inequality_names().empty());
+  const opt::Evaluation q = pen->evaluate(x);
   EXPECT_TRUE(q.inequality.empty());
   const double g_time = 0.4 / 0.3 - 1.0, g_mi = q.metrics.at("pct_mi") / 40 - 1.0;
   EXPECT_DOUBLE_EQ(q.metrics.at("g_startup_time"), g_time);
@@ -282,6 +288,70 @@ TEST(StartupProfileProblem, IdentityChangesWithWhatDecidesTheValues) {
   EXPECT_EQ(problems::fnv1a64("a"), 0xaf63dc4c8601ec8cull);   // published test vector
 }
 
+// Every key of abu, profile, motor and simulation (every leaf of their field lists, so a key added
+// later is covered too) changes the problem identity: an archive never answers with evaluations of
+// another model.
+TEST(StartupProfileProblem, AnySetupKeyChangesTheIdentity) {
+  std::string yaml = kThreeStep;  // random initial conditions: a third ball keeps the runs valid
+  const std::string grid = "montecarlo: {design: grid, grid: 2, threads: 1}";
+  yaml.replace(yaml.find(grid), grid.size(), "montecarlo: {design: random, runs: 4, threads: 1}");
+  const StartupProfileSettings base = settings_from(yaml);
+  const std::string id = StartupProfileProblem(base).identity();
+  std::size_t leaves = 0;
+  for (std::size_t k = 0;; ++k) {
+    StartupProfileSettings s = base;
+    test_support::PerturbArchive a(k);
+    describe_fields(a, s.study.setup);
+    if (!a.changed()) {
+      leaves = a.leaves();
+      break;
+    }
+    std::string changed;
+    try {
+      changed = StartupProfileProblem(s).identity();
+    } catch (const ConfigError& e) {
+      ADD_FAILURE() << a.changed_path() << ": " << e.what();
+      continue;
+    }
+    EXPECT_NE(changed, id) << a.changed_path();
+  }
+  EXPECT_GE(leaves, 8u + 1 + 4 + 1 + 1 + 6 + 8 + 13);  // abu (2 balls), profile (3 segments), motor, simulation
+}
+
+// Over every section of the settings: a field is in the identity exactly when it is marked so
+// (bounds, x0, scales, threads and the validation section are not), and read -> write -> read
+// gives the same settings after any single change.
+TEST(StartupProfileProblem, SettingsRoundTripAndIdentityFollowTheFieldLists) {
+  StartupProfileSettings base = settings_from(kThreeStep + "objective: {kind: weighted, weights: {mean: 1, pct_mi: 0.5}}\n");
+  const std::string id = identity_fields(base);
+  auto round_trip = [](const StartupProfileSettings& s) {
+    const std::string yaml = write_fields(s);
+    return settings_from(yaml);
+  };
+  EXPECT_EQ(write_fields(round_trip(base)), write_fields(base));
+  std::size_t outside = 0;
+  for (std::size_t k = 0;; ++k) {
+    StartupProfileSettings s = base;
+    test_support::PerturbArchive a(k);
+    describe_fields(a, s);
+    if (!a.changed()) break;
+    outside += !a.changed_identity();
+    EXPECT_EQ(identity_fields(s) != id, a.changed_identity()) << a.changed_path();
+    StartupProfileSettings back;
+    try {
+      back = round_trip(s);
+    } catch (const ConfigError& e) {
+      // A single change may break a rule across fields (a grid size against the runs): the
+      // reader must say so, never accept it silently.
+      EXPECT_NE(std::string(e.what()).find(" = "), std::string::npos) << a.changed_path();
+      continue;
+    }
+    EXPECT_EQ(write_fields(back), write_fields(s)) << a.changed_path();
+  }
+  // threads; min, max and x0 of the 5 free values and the one scale given; 5 validation keys.
+  EXPECT_EQ(outside, 1u + 5 * 3 + 1 + 5);
+}
+
 TEST(StartupProfileProblem, ConfigErrorsNameKeyValueAndRule) {
   auto err = [](const std::string& yaml) { return error_of([&] { settings_from(yaml); }); };
   const std::string head = "montecarlo: {design: grid, grid: 2}\n";
@@ -329,7 +399,7 @@ design:
   segments:
     - end_frequency_hz: {min: 20, max: 35, x0: 30}
       duration_s: 1
-    - end_frequency_hz: hold
+    - hold: true
       duration_s: {min: 0.5, max: 5, x0: 2}
     - end_frequency_hz: {min: 20, max: 35, x0: 28}
       duration_s: 3
@@ -344,14 +414,20 @@ design:
   EXPECT_DOUBLE_EQ(prof.segments()[1].end_frequency_hz, 31.5);
   EXPECT_DOUBLE_EQ(prof.frequency_hz(1.0 + 1.3), 31.5);  // constant through the hold
   EXPECT_DOUBLE_EQ(prof.segments()[2].end_frequency_hz, 27);  // falling segment
-  EXPECT_NE(p.identity_text().find("f2: hold"), std::string::npos);
+  EXPECT_NE(p.identity_text().find("hold: true"), std::string::npos);
+  // hold replaces end_frequency_hz: both in one segment is an error naming the key.
+  EXPECT_NE(error_of([] {
+              settings_from("montecarlo: {design: grid, grid: 2, threads: 1}\ndesign:\n  segments:\n"
+                            "    - {hold: true, end_frequency_hz: 30, duration_s: {min: 1, max: 2}}\n");
+            }).find("end_frequency_hz"),
+            std::string::npos);
   // A hold first segment dwells at the start frequency.
   StartupProfileProblem first(settings_from(R"(
 montecarlo: {design: grid, grid: 2, threads: 1}
 design:
   start_frequency_hz: 5
   segments:
-    - {end_frequency_hz: hold, duration_s: 1}
+    - {hold: true, duration_s: 1}
     - end_frequency_hz: {min: 20, max: 35}
       duration_s: 2
 )"));
@@ -377,9 +453,8 @@ TEST(StartupProfileProblem, AngularAccelerationConstraintIsExact) {
   ASSERT_TRUE(e.ok) << e.message;
   EXPECT_DOUBLE_EQ(e.inequality[0], 2 * M_PI * 2 * 35 / 0.4 / 500 - 1.0);
   EXPECT_DOUBLE_EQ(e.metrics.at("peak_angular_acceleration_rad_s2"), 2 * M_PI * 2 * 35 / 0.4);
-  // Unset, the identity is what it was before the constraint existed (archives stay valid).
-  EXPECT_EQ(StartupProfileProblem(settings_from(tiny("{kind: mean}"))).identity_text().find("angular"),
-            std::string::npos);
+  // The limit decides the constraint values, so it is part of the problem identity (archive key).
+  EXPECT_NE(StartupProfileProblem(settings_from(tiny("{kind: mean}"))).identity(), p.identity());
   EXPECT_NE(error_of([] { settings_from(tiny("{kind: mean}", "{max_angular_acceleration_rad_s2: -1}")); })
                 .find("constraints.max_angular_acceleration_rad_s2"),
             std::string::npos);

@@ -49,12 +49,16 @@ struct NondimParameters {
   static NondimParameters from(const AbuParameters& p);
 };
 
-// Non-dimensional state layout: [x, y, x', y', beta_1..beta_N, beta_1'..beta_N'].
+// Non-dimensional state layout: [x, y, x', y', beta_1..beta_N, beta_1'..beta_N'], followed by the
+// PI motor's two states [delta = theta_ref - theta, W] when it is modelled.
 struct StateLayout {
+  static constexpr std::size_t x = 0, y = 1, x_dot = 2, y_dot = 3, table_size = 4;
   std::size_t n_balls;
-  std::size_t size() const { return 4 + 2 * n_balls; }
-  std::size_t beta(std::size_t i) const { return 4 + i; }
-  std::size_t beta_dot(std::size_t i) const { return 4 + n_balls + i; }
+  std::size_t size() const { return table_size + 2 * n_balls; }  // the ABU's states
+  std::size_t beta(std::size_t i) const { return table_size + i; }
+  std::size_t beta_dot(std::size_t i) const { return table_size + n_balls + i; }
+  std::size_t motor_delta() const { return size(); }
+  std::size_t motor_speed() const { return size() + 1; }
 };
 
 // Accelerations and contact forces for one state and set of modes.

@@ -55,8 +55,8 @@ struct ResidualImbalanceStats {
 };
 
 // Number of RunStatus values, and a stable snake_case key for each ("ok", "solver_failure",
-// "chatter_limit", "step_limit") used in JSON and CSV.
-inline constexpr std::size_t kRunStatusCount = 4;
+// "chatter_limit", "step_limit", "event_limit") used in JSON and CSV.
+inline constexpr std::size_t kRunStatusCount = 5;
 std::string status_key(RunStatus s);
 
 struct MonteCarloStats {

@@ -8,8 +8,9 @@ namespace abuopt {
 enum class RunStatus {
   Ok,             // reached the end time
   SolverFailure,  // the integrator failed (message says how)
-  ChatterLimit,   // too many stick/slip events in a short time (guard tripped)
+  ChatterLimit,   // too many stick/slip events in a short time (chatter guard tripped)
   StepLimit,      // step budget exhausted
+  EventLimit,     // event budget (max_events) exhausted
 };
 std::string to_string(RunStatus s);
 

@@ -6,7 +6,9 @@
 // functions locate slip->stick (beta_i' = 0) and stick->slip (needed friction reaches mu fn_i);
 // at every event the modes of all balls are chosen together and the integrator restarts. The
 // report's own method (Leine's switch model: a thin band |beta'| < eta treated as stick) is an
-// option on the same model. Numerical trouble is an outcome status, never an exception.
+// option on the same model. Integration uses the native explicit Runge-Kutta stepper with
+// ARKODE's Butcher tables by default (IntegratorBackend::Native); SUNDIALS ARKODE's ERKStep is
+// the reference back end (ArkodeErk). Numerical trouble is an outcome status, never an exception.
 #include <optional>
 #include <string>
 #include <vector>
@@ -34,7 +36,7 @@ struct SimulationOptions {
   double end_time_s = 0;           // <= 0: twice the profile duration (report's rule)
   double switch_band = 1e-4;       // switch model: |beta'| / omega_n below this counts as stick
   long max_steps = 2'000'000;
-  long max_events = 100'000;       // total stick/slip transitions
+  long max_events = 100'000;       // total events; more ends the run with status EventLimit
   // Chatter guard: more than chatter_events transitions within chatter_window_s ends the run
   // with status ChatterLimit.
   long chatter_events = 200;
@@ -73,7 +75,7 @@ class Simulator {
   Simulator& operator=(const Simulator&) = delete;
   Simulator(Simulator&&) noexcept;
 
-  // beta0.size() must equal the number of balls (ConfigError otherwise).
+  // beta0.size() must equal the number of balls (std::invalid_argument otherwise: API misuse).
   RunOutcome run(const std::vector<double>& beta0, const RunOverrides& overrides = {},
                  std::vector<TrajectoryPoint>* trajectory = nullptr) const;
 

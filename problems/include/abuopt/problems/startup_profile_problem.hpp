@@ -26,9 +26,10 @@
 //   amplitude:     A / max_amplitude_mm - 1 <= 0, A = max over runs of the peak amplitude
 //                  (amplitude: max, default) or the mean over runs of it (amplitude: mean)
 //   pct_mi:        %MI / max_pct_mi - 1 <= 0                    (definition of the objective)
-//   angular_acceleration: a / max_angular_acceleration_rad_s2 - 1 <= 0, a = peak_angular_acceleration()
-// With constraints.penalty_weight = w > 0 the problem declares NO constraints (for bound-only
-// optimisers) and minimises objective + w * sum_i max(0, g_i) instead (exact L1 penalty).
+//   angular_acceleration: a / max_angular_acceleration_rad_s2 - 1 <= 0, a = peak_angular_acceleration_rad_s2
+// The problem always declares its constraints. With constraints.penalty_weight = w > 0 the
+// optimisers see its penalty form instead (make_startup_profile_problem, opt::PenaltyProblem): no
+// declared constraints (for bound-only optimisers), objective + w * sum_i max(0, g_i) (exact L1).
 //
 // A failed evaluation (opt::Evaluation::failed, never an exception): a profile with a duration
 // that is not > 0 (never simulated), every run of a pass failing, or more failed runs than
@@ -38,14 +39,17 @@
 //   ir_magnitude_{mean,median,max}, ir_x_{mean,median,max}, pct_mi_magnitude, pct_mi_x, pct_mi
 //   (the constrained/optimised definition), pct_lc, amplitude_max_mm, amplitude_mean_mm,
 //   startup_time_s, end_time_s, runs, failed_runs, mc_wall_time_s; with a robust set also
-//   objective_mu<k>, mu<k> and pct_mi_mu<k> for k = 1..K; with a penalty, g_<name> per constraint.
+//   objective_mu<k>, mu<k> and pct_mi_mu<k> for k = 1..K (the penalty form adds g_<name> per
+//   constraint and objective_without_penalty).
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "abuopt/common/config_fields.hpp"
 #include "abuopt/common/yaml_reader.hpp"
 #include "abuopt/core/initial_conditions.hpp"
 #include "abuopt/core/monte_carlo.hpp"
@@ -58,7 +62,6 @@ namespace abuopt::problems {
 // One value of a segment: fixed, or a free design variable with bounds.
 struct DesignValue {
   bool free = false;
-  bool hold = false;    // end frequency only: equal to the previous segment's end (a dwell), no variable
   double value = 0.0;   // fixed: the value; free: the starting point x0
   double lower = 0.0;   // free only
   double upper = 0.0;   // free only
@@ -66,7 +69,8 @@ struct DesignValue {
 };
 
 struct SegmentDesign {
-  DesignValue end_frequency_hz;  // variable name f<i> (1-based)
+  bool hold = false;             // a dwell: end frequency = the previous end (start) frequency, no variable
+  DesignValue end_frequency_hz;  // variable name f<i> (1-based); unused with hold
   DesignValue duration_s;        // variable name dt<i>
 };
 
@@ -75,16 +79,19 @@ struct ProfileDesign {
   std::vector<SegmentDesign> segments;
 };
 
-enum class ObjectiveKind { mean, pct_mi, weighted };
-enum class ImbalanceDefinition { magnitude, report_x };
-enum class AmplitudeStatistic { max, mean };
+enum class ObjectiveKind { Mean, PctMi, Weighted };
+enum class ImbalanceDefinition { Magnitude, ReportX };
+enum class AmplitudeStatistic { Max, Mean };
+extern const EnumNames<ObjectiveKind> kObjectiveKindNames;              // mean, pct_mi, weighted
+extern const EnumNames<ImbalanceDefinition> kImbalanceDefinitionNames;  // magnitude, report_x
+extern const EnumNames<AmplitudeStatistic> kAmplitudeStatisticNames;    // max, mean
 std::string to_string(ObjectiveKind k);
 std::string to_string(ImbalanceDefinition d);
 std::string to_string(AmplitudeStatistic a);
 
 struct ObjectiveSettings {
-  ObjectiveKind kind = ObjectiveKind::mean;
-  ImbalanceDefinition definition = ImbalanceDefinition::magnitude;
+  ObjectiveKind kind = ObjectiveKind::Mean;
+  ImbalanceDefinition definition = ImbalanceDefinition::Magnitude;
   double weight_mean = 1.0;    // weighted: per 1e-7 kg m of mean I_r
   double weight_pct_mi = 0.0;  // weighted: per percent of %MI
   // Robust objective: average over these friction coefficients; empty: one pass with the
@@ -97,12 +104,12 @@ struct ObjectiveSettings {
 struct ConstraintSettings {
   std::optional<double> max_startup_time_s;
   std::optional<double> max_amplitude_mm;
-  AmplitudeStatistic amplitude = AmplitudeStatistic::max;
+  AmplitudeStatistic amplitude = AmplitudeStatistic::Max;
   std::optional<double> max_pct_mi;
   // Peak angular acceleration of the profile, max over segments of 2 pi * 2 |H| / dt [rad/s^2]
   // (exact, no noise): what the drive must be able to follow.
   std::optional<double> max_angular_acceleration_rad_s2;
-  double penalty_weight = 0.0;  // > 0: constraints folded into the objective (no declared constraints)
+  double penalty_weight = 0.0;  // > 0: optimised in penalty form (make_startup_profile_problem)
 };
 
 // The out-of-sample check of the app: a fresh, larger set of initial conditions.
@@ -124,6 +131,17 @@ struct StartupProfileSettings {
   ConstraintSettings constraints;
   ValidationSettings validation;
 };
+
+// The field lists of the sections (common/config_fields.hpp): reading, writing, validation and the
+// problem identity all come from them. The design's absent segment values come from the profile
+// template; the validation section's defaults from the montecarlo section.
+void describe_fields(FieldArchive& a, ObjectiveSettings& o);
+void describe_fields(FieldArchive& a, ConstraintSettings& c);
+void describe_design_fields(FieldArchive& a, ProfileDesign& d, const StartupProfile& profile_template);
+void describe_validation_fields(FieldArchive& a, ValidationSettings& v, const MonteCarloStudy& study);
+// Every section of the settings: abu, profile, motor, simulation, montecarlo, design, objective,
+// constraints, validation.
+void describe_fields(FieldArchive& a, StartupProfileSettings& s);
 
 // Reads the sections abu, profile, motor, simulation, montecarlo, design, objective, constraints
 // and validation of `root` (docs/optimize.md lists every key). Leaves the other sections (optimizer,
@@ -170,10 +188,11 @@ class StartupProfileProblem : public opt::Problem {
   // The validation set of the settings as (design, runs, seed) for evaluate_profile.
   opt::Evaluation evaluate_out_of_sample(const StartupProfile& profile) const;
 
-  // Everything that decides the value of evaluate(x) as canonical text: the resolved setup
-  // (to_yaml), the fixed values and the order of the free variables, the Monte Carlo sampling, the
-  // objective and the constraints. Not in it (changing them keeps archived evaluations valid):
-  // bounds, x0, scales, threads, validation, optimizer settings.
+  // Everything that decides the value of evaluate(x) as canonical text, derived from the field
+  // lists (identity_fields of the settings): every key of abu, profile, motor, simulation, the
+  // Monte Carlo sampling, the fixed values and the order of the free variables, the objective and
+  // the constraints. Not in it (changing them keeps archived evaluations valid): bounds, x0,
+  // scales, threads, the validation section, optimizer settings.
   std::string identity_text() const;
   // "startup_profile-<16 hex digits of fnv1a64(identity_text())>": the archive's problem id.
   std::string identity() const;
@@ -190,5 +209,14 @@ class StartupProfileProblem : public opt::Problem {
   std::vector<Slot> slots_;
   std::vector<std::string> constraint_names_;
 };
+
+}  // namespace abuopt::problems
+
+namespace abuopt::problems {
+
+// The problem as the optimisers see it: a StartupProfileProblem, or with
+// constraints.penalty_weight > 0 its exact-L1-penalty form (opt::PenaltyProblem owning it). Throws
+// ConfigError for invalid settings.
+std::unique_ptr<opt::Problem> make_startup_profile_problem(const StartupProfileSettings& settings);
 
 }  // namespace abuopt::problems

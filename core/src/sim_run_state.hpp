@@ -1,0 +1,84 @@
+#pragma once
+// Internal to the simulator: the state of one run (the integrators' user data) and the functions
+// the integrators call: right-hand side and root functions (sim_rhs.cpp), the closed-form tail
+// (closed_form_tail.cpp). See simulator.cpp for the event logic and docs/model.md for the maths.
+#include <cmath>
+#include <vector>
+
+#include "abuopt/core/abu_model.hpp"
+#include "abuopt/core/simulator.hpp"
+
+namespace abuopt::detail {
+
+constexpr double kTwoPi = 2.0 * M_PI;
+
+inline double wrap_angle(double a) {
+  double r = std::fmod(a, kTwoPi);
+  if (r < 0) r += kTwoPi;
+  if (r >= kTwoPi) r = 0;
+  return r;
+}
+
+// Everything one run needs; ARKODE's user data.
+struct RunState {
+  AbuParameters params;  // with the run's overrides applied
+  NondimParameters nd;
+  AbuModel model;
+  const StartupProfile* profile = nullptr;
+  MotorModel motor;
+  SimulationOptions opt;
+  double mu = 0;
+  double omega_n = 0;
+  std::size_t n = 0;
+  std::size_t nstate = 0;  // ABU states (+2 motor states for the PI model)
+  bool pi_motor = false;
+  std::vector<BallMode> modes;
+  ModelForces forces;
+  std::vector<double> off_a, off_b;
+  long rhs_evals = 0;
+  // Fast path while every ball is stuck (event-driven, ideal motor): beta' = beta'' = 0, so the
+  // table rows reduce to x'' = -h_x, y'' = -h_y with the ball sums sum mbar_i (c_i, s_i) fixed.
+  // The full evaluation is still used for the root functions (they need fn, fw).
+  bool frozen = false;
+  double frozen_sc = 0, frozen_ss = 0;
+
+  const StateLayout& lay() const { return model.layout(); }
+
+  explicit RunState(const AbuParameters& p) : params(p), nd(NondimParameters::from(p)), model(nd) {}
+
+  // Call whenever the modes change (event-driven only).
+  void modes_changed(const double* y) {
+    frozen = !pi_motor && opt.method == FrictionMethod::EventDriven;
+    frozen_sc = frozen_ss = 0;
+    for (std::size_t i = 0; i < n && frozen; ++i) {
+      frozen = modes[i] == BallMode::Stick;
+      frozen_sc += nd.mbar[i] * std::cos(y[lay().beta(i)]);
+      frozen_ss += nd.mbar[i] * std::sin(y[lay().beta(i)]);
+    }
+  }
+};
+
+struct Speed {
+  double W = 0, Wp = 0;
+};
+
+inline Speed ideal_speed(const RunState& rs, double tbar) {
+  const ProfileSample s = rs.profile->sample(tbar / rs.omega_n);
+  return {kTwoPi * s.frequency_hz / rs.omega_n, kTwoPi * s.rate_hz_per_s / (rs.omega_n * rs.omega_n)};
+}
+
+// Evaluates forces for the current modes into rs.forces and returns the speed used (sim_rhs.cpp).
+Speed evaluate_forces(RunState& rs, double tbar, const double* y);
+// Switch model: chooses the modes at every right-hand-side call.
+void switch_modes(RunState& rs, double tbar, const double* y);
+// Right-hand side and root functions with the native stepper's signatures.
+void rhs_plain(double tbar, const double* y, double* yd, void* user);
+void roots_plain(double tbar, const double* y, double* g, void* user);
+// Shifts the stick margins that start negative (by rounding) so their crossing is still seen.
+void set_root_offsets(RunState& rs, double tbar, const double* y);
+bool all_stuck(const RunState& rs, const double* y);
+// After the profile, with every ball stuck and an ideal motor: finishes the run in closed form
+// when a bound proves no ball can slip again (closed_form_tail.cpp).
+bool closed_form_tail(RunState& rs, double tbar, std::vector<double>& y, double tbar_end, double& peak_amp);
+
+}  // namespace abuopt::detail

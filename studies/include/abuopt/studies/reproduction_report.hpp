@@ -1,0 +1,63 @@
+#pragma once
+// The reproduction's results and how they are written: the per-table results, the report (Markdown
+// and plain text) and tables.csv.
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "abuopt/core/monte_carlo.hpp"
+#include "abuopt/studies/reproduction_table.hpp"
+#include "abuopt/studies/verdicts.hpp"
+
+namespace abuopt {
+
+// --- Running and reporting ----------------------------------------------------------------------
+
+struct TableResult {
+  ReproductionTable table;
+  std::vector<CaseSummary> rows;            // one per case, in case order
+  std::vector<MonteCarloResult> results;    // the samples (for the plots)
+  std::vector<Verdict> verdicts;
+  double wall_time_s = 0;
+};
+
+struct PlotNote {
+  std::string name;     // file stem
+  std::string png;      // path of the PNG (if made)
+  std::string csv;      // its data
+  bool made = false;
+  std::string message;  // "ok", or why it was skipped
+};
+
+struct ReproductionOptions {
+  std::string out_dir;           // required: everything goes here
+  std::size_t threads = 0;       // 0: all cores
+  bool plots = true;
+  std::string command_line;      // for the report's settings section
+  std::string runs_note;         // from override_runs, for the report ("" = report's run counts)
+  // One progress line per finished case (and a few more); the app prints them on stderr.
+  std::function<void(const std::string& line)> log;
+};
+
+struct ReproductionReport {
+  std::vector<TableResult> tables;
+  std::vector<PlotNote> plots;
+  double wall_time_s = 0;
+  std::size_t concurrency = 1;
+  std::string markdown_path, tables_csv_path;
+  std::vector<Verdict> verdicts() const;  // of every table, in order
+};
+
+// The table side by side with the report's values, as plain text (for the terminal).
+std::string format_table_text(const TableResult& t);
+// The same as a Markdown table (with the table's heading and verdicts).
+std::string format_table_markdown(const TableResult& t);
+// The whole Markdown report.
+std::string format_report_markdown(const ReproductionReport& r, const ReproductionOptions& opt);
+
+// tables.csv: the header line, and one line per case.
+std::string tables_csv_header();
+std::string tables_csv_line(const CaseSummary& s);
+
+}  // namespace abuopt

@@ -1,0 +1,206 @@
+#include "reproduction_plots.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "abuopt/core/equilibrium_set.hpp"
+#include "output_dir.hpp"
+#include "study_text.hpp"
+
+namespace abuopt::studies_detail {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const MonteCarloResult* find_result(const TableResult& t, const std::string& case_id) {
+  for (std::size_t i = 0; i < t.table.cases.size() && i < t.results.size(); ++i)
+    if (t.table.cases[i].id == case_id) return &t.results[i];
+  return nullptr;
+}
+
+PlotNote finish_note(PlotNote n, const PlotStatus& st) {
+  n.made = st.ran();
+  n.png = st.png_path;
+  n.message = st.message;
+  return n;
+}
+
+}  // namespace
+
+PlotNote plot_trend(const Gnuplot& gp, const TableResult& t, const PlotRequest& req, const fs::path& dir) {
+  PlotNote note;
+  note.name = req.name;
+  note.csv = (dir / (req.name + ".csv")).string();
+  std::ostringstream csv;
+  csv << "value,mean_x_1e7,pct_mi_x,pct_mi_x_ci_lo,pct_mi_x_ci_hi,ref_mean_1e7,ref_pct_mi,mean_mag_1e7,pct_mi_mag\n";
+  std::size_t points = 0;
+  for (const CaseSummary& s : t.rows) {
+    if (!s.value || s.ok == 0) continue;
+    ++points;
+    csv << csv_num(*s.value) << ',' << csv_num(s.mean_x) << ',' << csv_num(s.pct_mi_x) << ',' << csv_num(s.ci_x[0])
+        << ',' << csv_num(s.ci_x[1]) << ',' << csv_opt(s.reference.mean_1e7) << ',' << csv_opt(s.reference.pct_mi)
+        << ',' << csv_num(s.mean_mag) << ',' << csv_num(s.pct_mi_mag) << '\n';
+  }
+  write_text_file(note.csv, csv.str());
+  if (points == 0) {
+    note.message = "skipped: no case with a value";
+    return note;
+  }
+  const std::string data = Gnuplot::quote(note.csv);
+  const std::string xl = t.table.parameter_name + (t.table.parameter_unit.empty() ? "" : " [" + t.table.parameter_unit + "]");
+  std::ostringstream b;
+  b << "set datafile separator ','\n"
+    << "set datafile missing ''\n"
+    << "set title " << Gnuplot::quote(table_heading(t.table) + ": ours (I_r,x) and the report") << "\n"
+    << "set xlabel " << Gnuplot::quote(xl) << "\n"
+    << "set ylabel 'mean I_r,x [1e-7 kg m]'\n"
+    << "set y2label '%MI [%]'\n"
+    << "set ytics nomirror\nset y2tics\nset grid\nset key outside below\nset offsets graph 0.03, graph 0.03, 0, 0\n"
+    << "plot " << data << " skip 1 using 1:2 with linespoints pt 7 lc rgb '#1f77b4' title 'mean I_r,x (ours)', \\\n"
+    << "     " << data << " skip 1 using 1:6 with points pt 6 ps 1.5 lc rgb '#1f77b4' title 'mean (report)', \\\n"
+    << "     " << data
+    << " skip 1 using 1:3:4:5 axes x1y2 with yerrorlines pt 5 lc rgb '#d62728' title '%MI (ours, 95 % CI)', \\\n"
+    << "     " << data << " skip 1 using 1:7 axes x1y2 with points pt 4 ps 1.5 lc rgb '#d62728' title '%MI (report)'\n";
+  const std::string png = (dir / (req.name + ".png")).string();
+  return finish_note(note, gp.run(b.str(), (dir / (req.name + ".gp")).string(), png, 900, 650));
+}
+
+PlotNote plot_final_positions(const Gnuplot& gp, const TableResult& t, const PlotRequest& req, const fs::path& dir) {
+  PlotNote note;
+  note.name = req.name;
+  note.csv = (dir / (req.name + ".csv")).string();
+  std::vector<const MonteCarloResult*> res;
+  std::vector<std::string> labels;
+  std::size_t rows = 0;
+  for (const std::string& id : req.case_ids) {
+    const MonteCarloResult* r = find_result(t, id);
+    if (!r) continue;
+    res.push_back(r);
+    labels.push_back(t.table.find_case(id)->label);
+    rows = std::max(rows, r->samples.size());
+  }
+  std::ostringstream csv;
+  for (std::size_t k = 0; k < res.size(); ++k)
+    csv << (k ? "," : "") << "beta1_" << req.case_ids[k] << "_rad,beta2_" << req.case_ids[k] << "_rad";
+  csv << '\n';
+  for (std::size_t i = 0; i < rows; ++i) {
+    for (std::size_t k = 0; k < res.size(); ++k) {
+      if (k) csv << ',';
+      const auto& smp = res[k]->samples;
+      if (i < smp.size() && smp[i].outcome.ok() && smp[i].outcome.beta_final.size() >= 2)
+        csv << csv_num(smp[i].outcome.beta_final[0]) << ',' << csv_num(smp[i].outcome.beta_final[1]);
+      else
+        csv << ',';
+    }
+    csv << '\n';
+  }
+  write_text_file(note.csv, csv.str());
+  XYLinesPlot p;
+  p.csv_path = note.csv;
+  p.png_path = (dir / (req.name + ".png")).string();
+  p.width_px = 800;
+  p.height_px = 800;
+  p.labels = {"Final ball positions (cf. report fig 4.7)", "beta_1 [rad]", "beta_2 [rad]"};
+  for (std::size_t k = 0; k < res.size(); ++k)
+    p.series.push_back({static_cast<int>(2 * k + 1), static_cast<int>(2 * k + 2), labels[k], "points"});
+  return finish_note(note, gp.xy_lines(p));
+}
+
+PlotNote plot_settling(const Gnuplot& gp, const TableResult& t, const PlotRequest& req, const fs::path& dir) {
+  PlotNote note;
+  note.name = req.name;
+  note.csv = (dir / (req.name + ".csv")).string();
+  const MonteCarloResult* r = find_result(t, req.case_ids.front());
+  std::ostringstream csv;
+  csv << "settling_time_s\n";
+  std::size_t n = 0;
+  if (r)
+    for (const MonteCarloSample& s : r->samples)
+      if (s.outcome.ok() && s.outcome.settled) {
+        csv << csv_num(s.outcome.settling_time_s) << '\n';
+        ++n;
+      }
+  write_text_file(note.csv, csv.str());
+  if (n < 2) {
+    note.message = "skipped: fewer than two settled runs";
+    return note;
+  }
+  HistogramPlot p;
+  p.csv_path = note.csv;
+  p.png_path = (dir / (req.name + ".png")).string();
+  p.labels = {"Settling time, " + t.table.find_case(req.case_ids.front())->label + " (" + std::to_string(n) +
+                  " settled runs)",
+              "settling time [s]", "runs"};
+  p.bins = 40;
+  return finish_note(note, gp.histogram(p));
+}
+
+PlotNote plot_equilibrium(const Gnuplot& gp, const TableResult& t, const PlotRequest& req, const fs::path& dir) {
+  PlotNote note;
+  note.name = req.name;
+  note.csv = (dir / (req.name + ".csv")).string();
+  const ReproductionCase* c = t.table.find_case(req.case_ids.front());
+  const MonteCarloResult* r = find_result(t, req.case_ids.front());
+  if (!c || !r || c->study.setup.abu.balls.size() != 2) {
+    note.message = "skipped: needs a two-ball case that ran";
+    return note;
+  }
+  const double f = c->study.setup.profile.final_frequency_hz();
+  const EquilibriumSet set(c->study.setup.abu);
+  const std::size_t n = 96;
+  const EquilibriumGrid g = set.grid(f, n);
+  // Grid data for gnuplot's image style: one scan per beta_1, blank line between scans.
+  const std::string grid_csv = (dir / (req.name + ".grid.csv")).string();
+  {
+    std::ostringstream os;
+    os << "beta1_rad,beta2_rad,in_set,steady_amplitude_mm\n";
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t j = 0; j < n; ++j)
+        os << csv_num(g.beta(i)) << ',' << csv_num(g.beta(j)) << ',' << int(g.in_set[g.index(i, j)]) << ','
+           << csv_num(g.amplitude_mm[g.index(i, j)]) << '\n';
+      os << '\n';
+    }
+    write_text_file(grid_csv, os.str());
+  }
+  {
+    std::ostringstream os;
+    os << "beta1_final_rad,beta2_final_rad,ir_x_1e7\n";
+    for (const MonteCarloSample& s : r->samples)
+      if (s.outcome.ok() && s.outcome.beta_final.size() == 2)
+        os << csv_num(s.outcome.beta_final[0]) << ',' << csv_num(s.outcome.beta_final[1]) << ','
+           << csv_num(s.outcome.residual_imbalance_x_kgm * 1e7) << '\n';
+    write_text_file(note.csv, os.str());
+  }
+  // Frictionless balancing positions: beta = +- arccos(-m_I e / (2 m L)).
+  const AbuParameters& a = c->study.setup.abu;
+  const double ratio = a.imbalance_kgm() / (2.0 * a.balls[0].mass_kg * a.ball_track_radius_m);
+  std::ostringstream b;
+  b << "set datafile separator ','\n"
+    << "set title " << Gnuplot::quote("Final positions over the equilibrium set at " + num(f, 1) + " Hz (mu = " +
+                                      short_num(a.friction_mu) + "; coverage " + num(100.0 * g.coverage(), 1) + " %)")
+    << "\n"
+    << "set xlabel 'beta_1 [rad]'\nset ylabel 'beta_2 [rad]'\nset size square\n"
+    << "set xrange [0:2*pi]\nset yrange [0:2*pi]\n"
+    << "set palette defined (0 '#ffffff', 1 '#c6dbef', 2 '#6baed6', 3 '#2171b5')\n"
+    << "set cblabel 'steady amplitude with the balls stuck there [mm]'\n"
+    << "set key outside below\n";
+  if (ratio < 1.0) {
+    const double bb = std::acos(-ratio);
+    b << "set label 1 '' at " << bb << "," << 2 * M_PI - bb << " point pt 3 ps 3 lw 2 lc rgb '#d62728' front\n"
+      << "set label 2 '' at " << 2 * M_PI - bb << "," << bb << " point pt 3 ps 3 lw 2 lc rgb '#d62728' front\n";
+  }
+  b << "plot " << Gnuplot::quote(grid_csv)
+    << " skip 1 using 1:2:4 with image title 'steady amplitude (background)', \\\n"
+    << "     " << Gnuplot::quote(grid_csv)
+    << " skip 1 using 1:(column(3) < 0.5 ? column(2) : NaN) with points pt 1 ps 0.4 lc rgb '#888888' "
+       "title 'outside the equilibrium set', \\\n"
+    << "     " << Gnuplot::quote(note.csv)
+    << " skip 1 using 1:2 with points pt 7 ps 0.6 lc rgb '#000000' title 'final positions (red stars: frictionless "
+       "balancing positions)'\n";
+  const std::string png = (dir / (req.name + ".png")).string();
+  return finish_note(note, gp.run(b.str(), (dir / (req.name + ".gp")).string(), png, 820, 860));
+}
+
+}  // namespace abuopt::studies_detail
