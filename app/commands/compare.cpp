@@ -31,6 +31,7 @@
 #include <nlohmann/json.hpp>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/common/output_file.hpp"
 #include "abuopt/optimizer/benchmarking.hpp"
 #include "abuopt/optimizer/benchmarks/benchmark_factory.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
@@ -123,9 +124,10 @@ int run_compare(const CompareArgs& a) {
     std::cerr << "[" << done << "/" << total << "] " << r.problem << " start " << r.start << " " << r.solver << ": "
               << r.result.brief_report() << "\n";
   };
+  const std::string out = a.out.empty() ? "results/compare-" + timestamp() : a.out;
+  const OutputDirLock lock(out);  // one run per output directory (created here)
   const opt::ComparisonResult result = opt::run_comparison(setup);
 
-  const std::string out = a.out.empty() ? "results/compare-" + timestamp() : a.out;
   const opt::WrittenFiles files = opt::write_comparison(result, out);
 
   if (a.json) {
