@@ -110,6 +110,7 @@ int run_compare(const CompareArgs& a) {
   YamlReader root = YamlReader::load_file(a.config);
   opt::ComparisonSetup setup;
   setup.tau = root.get_double_or("tau", setup.tau, Rule::in_range(1e-12, 0.999));
+  setup.threads = static_cast<int>(root.get_int_or("threads", setup.threads, Rule::in_range(1, 256)));
   for (YamlReader& p : root.children("problems")) setup.problems.push_back(read_problem(p));
   for (YamlReader& s : root.children("solvers")) setup.solvers.push_back(opt::read_solver_spec(s));
   root.finish();
