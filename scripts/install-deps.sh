@@ -16,6 +16,7 @@ packages=(
   libgtest-dev           # tests
   libbenchmark-dev       # bench/
   gnuplot-nox            # plots (optional at run time: studies skip plots without it)
+  clang libclang-rt-14-dev  # libFuzzer targets (fuzz/, scripts/fuzz.sh) with ASan/UBSan runtimes
 )
 
 missing=()
