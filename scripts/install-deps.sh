@@ -16,6 +16,7 @@ packages=(
   libgtest-dev           # tests
   libbenchmark-dev       # bench/
   gnuplot-nox            # plots (optional at run time: studies skip plots without it)
+  python3                # scripts/startup_study.py, scripts/final_states_in_set.py (standard library only)
 )
 
 missing=()
