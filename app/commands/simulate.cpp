@@ -11,6 +11,7 @@
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/text.hpp"
+#include "abuopt/core/monte_carlo.hpp"
 #include "abuopt/core/simulation_config.hpp"
 #include "abuopt/core/simulator.hpp"
 #include "commands/commands.hpp"
@@ -49,6 +50,8 @@ std::vector<double> parse_angles(const std::string& text, std::size_t balls) {
 int run_simulate(const SimulateArgs& a) {
   YamlReader root = YamlReader::load_file(a.config);
   SimulationSetup setup = read_simulation_setup(root);
+  // A montecarlo section (a config that `abuopt montecarlo` also runs) is checked and not used.
+  if (root.has("montecarlo")) (void)read_monte_carlo_config(root, setup);
   root.finish();
   if (a.mu) {
     if (!(std::isfinite(*a.mu) && *a.mu >= 0 && *a.mu <= 0.999))
