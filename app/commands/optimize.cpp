@@ -18,6 +18,7 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/gnuplot.hpp"
+#include "abuopt/common/text.hpp"
 #include "abuopt/core/simulation_config.hpp"
 #include "abuopt/optimizer/evaluation_archive.hpp"
 #include "abuopt/optimizer/minimize.hpp"
@@ -105,16 +106,7 @@ nlohmann::json evaluation_json(const opt::Evaluation& e, const std::vector<std::
   return j;
 }
 
-std::string csv_number(double v) { return std::isfinite(v) ? format_number(v) : (std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf")); }
-
-std::string csv_text(std::string s) {
-  for (char& c : s)
-    if (c == '\n' || c == '\r') c = ' ';
-  if (s.find_first_of(",\"") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
-}
+std::string csv_text(const std::string& s) { return csv_field(s); }
 
 std::ofstream open_out(const fs::path& p) {
   std::ofstream f(p);

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/core/monte_carlo.hpp"
 #include "abuopt/core/simulation_config.hpp"
 #include "abuopt/core/simulator.hpp"
 #include "commands/commands.hpp"
@@ -46,6 +47,8 @@ std::vector<double> parse_angles(const std::string& text, std::size_t balls) {
 int run_simulate(const SimulateArgs& a) {
   YamlReader root = YamlReader::load_file(a.config);
   SimulationSetup setup = read_simulation_setup(root);
+  // A montecarlo section (a config that `abuopt montecarlo` also runs) is checked and not used.
+  if (root.has("montecarlo")) (void)read_monte_carlo_config(root, setup);
   root.finish();
   if (a.mu >= 0) setup.abu.friction_mu = a.mu;
   if (!a.trajectory.empty()) setup.options.trajectory_interval_s = a.trajectory_interval_s;

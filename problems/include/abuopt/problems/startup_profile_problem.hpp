@@ -32,6 +32,7 @@
 //                  (amplitude: max, default) or the mean over runs of it (amplitude: mean)
 //   pct_mi:        %MI / max_pct_mi - 1 <= 0                    (definition of the objective; the
 //                  smoothed exceedance with constraints.pct_mi_statistic: smooth)
+//   angular_acceleration: a / max_angular_acceleration_rad_s2 - 1 <= 0, a = peak_angular_acceleration_rad_s2
 // The problem always declares its constraints. With constraints.penalty_weight = w > 0 the
 // optimisers see its penalty form instead (make_startup_profile_problem, opt::PenaltyProblem): no
 // declared constraints (for bound-only optimisers), objective + w * sum_i max(0, g_i) (exact L1).
@@ -74,7 +75,8 @@ struct DesignValue {
 };
 
 struct SegmentDesign {
-  DesignValue end_frequency_hz;  // variable name f<i> (1-based)
+  bool hold = false;             // a dwell: end frequency = the previous end (start) frequency, no variable
+  DesignValue end_frequency_hz;  // variable name f<i> (1-based); unused with hold
   DesignValue duration_s;        // variable name dt<i>
 };
 
@@ -117,6 +119,9 @@ struct ConstraintSettings {
   AmplitudeStatistic amplitude = AmplitudeStatistic::Max;
   std::optional<double> max_pct_mi;
   PctMiStatistic pct_mi_statistic = PctMiStatistic::Exact;
+  // Peak angular acceleration of the profile, max over segments of 2 pi * 2 |H| / dt [rad/s^2]
+  // (exact, no noise): what the drive must be able to follow.
+  std::optional<double> max_angular_acceleration_rad_s2;
   double penalty_weight = 0.0;  // > 0: optimised in penalty form (make_startup_profile_problem)
 };
 
@@ -162,6 +167,10 @@ ProfileDesign read_profile_design(YamlReader design, const StartupProfile& profi
 // Throws ConfigError for an invalid design (no free variable, bounds reversed, x0 outside the
 // bounds, durations not > 0, ...), objective or constraint settings.
 void validate(const StartupProfileSettings& s);
+
+// Peak angular acceleration of a profile [rad/s^2]: an inclined sine of height H and duration dt
+// peaks at f' = 2 |H| / dt (at its middle), so a = max over segments of 2 pi * 2 |H| / dt.
+double peak_angular_acceleration_rad_s2(const StartupProfile& profile);
 
 // FNV-1a, 64 bits.
 std::uint64_t fnv1a64(std::string_view text);
