@@ -17,6 +17,8 @@ AbuParameters read_abu_parameters(YamlReader r) {
   p.eccentricity_m = r.get_double_or("eccentricity_m", p.eccentricity_m, Rule::non_negative());
   p.friction_mu = r.get_double_or("friction_mu", p.friction_mu, Rule::in_range(0.0, 0.999));
   p.ball_damping_Nms = r.get_double_or("ball_damping_Nms", p.ball_damping_Nms, Rule::non_negative());
+  p.ball_contact = r.get_choice_or("ball_contact", "none", {"none", "hard"}) == "hard" ? BallContact::Hard : BallContact::None;
+  p.ball_restitution = r.get_double_or("ball_restitution", p.ball_restitution, Rule::in_range(0.0, 1.0));
   const bool has_list = r.has("balls");
   const bool has_count = r.has("ball_count") || r.has("ball_mass_kg") || r.has("ball_diameter_m");
   if (has_list && has_count)
@@ -121,6 +123,10 @@ std::string to_yaml(const SimulationSetup& s) {
   e << YAML::Key << "eccentricity_m" << YAML::Value << s.abu.eccentricity_m;
   e << YAML::Key << "friction_mu" << YAML::Value << s.abu.friction_mu;
   e << YAML::Key << "ball_damping_Nms" << YAML::Value << s.abu.ball_damping_Nms;
+  if (s.abu.ball_contact != BallContact::None) {  // written when on: older configs (and archive identities) stay as they were
+    e << YAML::Key << "ball_contact" << YAML::Value << to_string(s.abu.ball_contact);
+    e << YAML::Key << "ball_restitution" << YAML::Value << s.abu.ball_restitution;
+  }
   e << YAML::Key << "balls" << YAML::Value << YAML::BeginSeq;
   for (const auto& b : s.abu.balls)
     e << YAML::Flow << YAML::BeginMap << YAML::Key << "mass_kg" << YAML::Value << b.mass_kg << YAML::Key
