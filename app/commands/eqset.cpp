@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/common/config_fields.hpp"
 #include "abuopt/common/gnuplot.hpp"
 #include "abuopt/core/equilibrium_set.hpp"
 #include "abuopt/core/simulation_config.hpp"
@@ -84,23 +85,26 @@ Scan parse_scan(const std::string& text) {
   return s;
 }
 
-EqsetConfig read_eqset_section(YamlReader r) {
-  EqsetConfig c;
-  if (!r.present()) return c;
-  if (r.has("frequency_hz")) c.frequency_hz = r.get_double("frequency_hz", Rule::positive());
-  if (r.has("grid")) c.grid = r.get_int("grid", Rule::in_range(2, kMaxGrid));
-  if (r.has("scan_hz")) {
-    auto v = r.get_double_list("scan_hz");
+// The eqset section's field list (common/config_fields.hpp).
+void describe_fields(FieldArchive& a, EqsetConfig& c) {
+  a.field("frequency_hz", c.frequency_hz, Rule::positive());
+  a.field("grid", c.grid, Rule::in_range(2, kMaxGrid));
+  a.field("scan_hz", c.scan_hz);
+  if (a.reading() && c.scan_hz) {
+    const auto& v = *c.scan_hz;
     std::ostringstream text;
     text << "[";
     for (std::size_t k = 0; k < v.size(); ++k) text << (k ? ", " : "") << v[k];
     text << "]";
-    if (v.size() != 3) throw ConfigError(r.key_path("scan_hz"), text.str(), "must be [from, to, step] in Hz");
-    check_scan(Scan{v[0], v[1], v[2]}, r.key_path("scan_hz"), text.str());
-    c.scan_hz = v;
+    if (v.size() != 3) throw ConfigError(a.path("scan_hz"), text.str(), "must be [from, to, step] in Hz");
+    check_scan(Scan{v[0], v[1], v[2]}, a.path("scan_hz"), text.str());
   }
-  if (r.has("other_angles_rad")) c.other_angles_rad = r.get_double_list("other_angles_rad");
-  r.finish();
+  a.field("other_angles_rad", c.other_angles_rad);
+}
+
+EqsetConfig read_eqset_section(YamlReader r) {
+  EqsetConfig c;
+  read_fields(r, c);
   return c;
 }
 

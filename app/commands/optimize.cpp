@@ -317,7 +317,7 @@ int run_optimize(const OptimizeArgs& a) {
   auto write_json = [&] { open_out(result_json) << j.dump(2) << "\n"; };
   write_json();
 
-  const bool interrupted = r.reason == opt::TerminationReason::interrupted;
+  const bool interrupted = r.reason == opt::TerminationReason::Interrupted;
   if (have_best && st.validation.enabled && !interrupted) {
     const auto& v = st.validation;
     log << "\nvalidation: " << v.runs << " fresh initial conditions (" << to_string(v.design) << ", seed " << v.seed

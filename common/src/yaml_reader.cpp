@@ -1,6 +1,8 @@
 #include "abuopt/common/yaml_reader.hpp"
 
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <sstream>
 
 namespace abuopt {
@@ -93,16 +95,17 @@ YAML::Node YamlReader::at(const std::string& key) {
 
 double YamlReader::scalar_as_double(const YAML::Node& n, const std::string& path, const Rule& rule) {
   if (!n.IsScalar()) throw ConfigError(path, yaml_value_text(n), "must be a number");
-  double v = 0;
   const std::string& s = n.Scalar();
-  try {
-    size_t used = 0;
-    v = std::stod(s, &used);
-    while (used < s.size() && std::isspace(static_cast<unsigned char>(s[used]))) ++used;
-    if (used != s.size()) throw std::invalid_argument("trailing");
-  } catch (const std::exception&) {
+  // strtod, not stod: stod rejects subnormal values (5e-324) as out of range, so a number that
+  // was written could not be read back. An overflow (1e400) is still not a number.
+  const char* begin = s.c_str();
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(begin, &end);
+  const bool overflow = errno == ERANGE && std::isinf(v);
+  while (end && *end != '\0' && std::isspace(static_cast<unsigned char>(*end))) ++end;
+  if (end == begin || end == nullptr || *end != '\0' || overflow || s.find('\0') != std::string::npos)
     throw ConfigError(path, s, "must be a number");
-  }
   const std::string broken = rule.check ? rule.check(v) : std::string();
   if (!broken.empty()) throw ConfigError(path, s, broken);
   return v;
@@ -181,6 +184,39 @@ std::vector<double> YamlReader::get_double_list(const std::string& key, const Ru
   if (!n.IsSequence()) throw ConfigError(key_path(key), yaml_value_text(n), "must be a number or a list of numbers");
   for (size_t i = 0; i < n.size(); ++i)
     out.push_back(scalar_as_double(n[i], key_path(key) + "[" + std::to_string(i) + "]", rule));
+  return out;
+}
+
+std::vector<std::string> YamlReader::get_string_list_or(const std::string& key, const std::vector<std::string>& fallback) {
+  YAML::Node n = at(key);
+  if (!n) return fallback;
+  std::vector<std::string> out;
+  if (n.IsScalar()) {
+    out.push_back(n.Scalar());
+    return out;
+  }
+  if (!n.IsSequence()) throw ConfigError(key_path(key), yaml_value_text(n), "must be a string or a list of strings");
+  for (size_t i = 0; i < n.size(); ++i) {
+    if (!n[i].IsScalar())
+      throw ConfigError(key_path(key) + "[" + std::to_string(i) + "]", yaml_value_text(n[i]), "must be a string");
+    out.push_back(n[i].Scalar());
+  }
+  return out;
+}
+
+YAML::Node merge_yaml(const YAML::Node& base, const YAML::Node& overlay) {
+  if (!overlay || overlay.IsNull()) return YAML::Clone(base);
+  if (!base || !base.IsMap() || !overlay.IsMap()) return YAML::Clone(overlay);
+  YAML::Node out = YAML::Clone(base);
+  for (auto it = overlay.begin(); it != overlay.end(); ++it) {
+    const std::string key = it->first.Scalar();
+    const YAML::Node& cout_ = out;  // const lookup: does not insert
+    const YAML::Node existing = cout_[key];
+    if (existing && existing.IsMap() && it->second.IsMap())
+      out[key] = merge_yaml(existing, it->second);
+    else
+      out[key] = YAML::Clone(it->second);
+  }
   return out;
 }
 

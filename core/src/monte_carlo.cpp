@@ -163,32 +163,36 @@ MonteCarloResult run_monte_carlo(const MonteCarloStudy& s, const SampleFunction&
   return result;
 }
 
+const EnumNames<InitialConditionKind> kInitialConditionKindNames = {
+    {InitialConditionKind::Grid, "grid"},     {InitialConditionKind::Random, "random"},
+    {InitialConditionKind::LatinHypercube, "lhs"}, {InitialConditionKind::Halton, "halton"},
+    {InitialConditionKind::Sobol, "sobol"}};
+
+void describe_montecarlo_fields(FieldArchive& a, MonteCarloStudy& st, std::size_t& threads) {
+  const bool runs_given = a.has("runs");
+  if (a.reading()) st.design.balls = st.setup.abu.balls.size();
+  a.field("design", st.design.kind, kInitialConditionKindNames);
+  a.field("grid", st.design.grid_points_per_axis, Rule::at_least(1));
+  a.field("runs", st.runs, Rule::at_least(1));
+  if (a.reading() && !runs_given)
+    st.runs = st.design.kind == InitialConditionKind::Grid ? st.design.size() : 1024;
+  a.field("seed", st.seed, Rule::in_range(0, 9007199254740992.0));
+  if (a.reading()) st.design.seed = st.seed;  // one seed in the config; a study built in code may differ
+  a.field("design_seed", st.design.seed, Rule::any(), FieldOptions::identity_only());
+  a.field("shift", st.design.random_shift);
+  a.field("reuse_exchangeable", st.reuse_exchangeable);
+  a.field("threads", threads, Rule::non_negative(), FieldOptions::not_identity());
+  describe_fields(a, st.uncertain);
+}
+
+void describe_fields(FieldArchive& a, MonteCarloConfig& c) { describe_montecarlo_fields(a, c.study, c.threads); }
+
 MonteCarloConfig read_monte_carlo_config(YamlReader& root, SimulationSetup setup) {
   MonteCarloConfig cfg;
-  MonteCarloStudy& st = cfg.study;
-  st.setup = std::move(setup);
+  cfg.study.setup = std::move(setup);
   YamlReader mc = root.child("montecarlo");
-  const std::string path = mc.path();
-
-  st.design.kind = initial_condition_kind_from_string(
-      mc.get_choice_or("design", "grid", {"grid", "random", "lhs", "halton", "sobol"}), mc.key_path("design"));
-  st.design.grid_points_per_axis = static_cast<std::size_t>(mc.get_int_or("grid", 32, Rule::at_least(1)));
-  st.design.balls = st.setup.abu.balls.size();
-  if (mc.has("runs")) {
-    st.runs = static_cast<std::size_t>(mc.get_int("runs", Rule::at_least(1)));
-  } else {
-    mc.get_int_or("runs", 0);  // marks the key as read
-    st.runs = st.design.kind == InitialConditionKind::Grid ? st.design.size() : 1024;
-  }
-  const long seed = mc.get_int_or("seed", 0, Rule::in_range(0, 9007199254740992.0));
-  st.seed = static_cast<std::uint64_t>(seed);
-  st.design.seed = st.seed;
-  st.design.random_shift = mc.get_bool_or("shift", true);
-  st.reuse_exchangeable = mc.get_bool_or("reuse_exchangeable", true);
-  cfg.threads = static_cast<std::size_t>(mc.get_int_or("threads", 0, Rule::non_negative()));
-  st.uncertain = read_uncertain_parameters(mc);
-  mc.finish();
-  validate(st, path);
+  read_fields(mc, cfg);
+  validate(cfg.study, mc.path());
   return cfg;
 }
 

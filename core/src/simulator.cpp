@@ -28,6 +28,7 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/core/abu_model.hpp"
+#include "abuopt/core/simulation_config.hpp"
 #include "integrator.hpp"
 #include "sim_run_state.hpp"
 
@@ -51,10 +52,9 @@ using namespace detail;
 Simulator::Simulator(SimulationSetup setup) : setup_(std::move(setup)) {
   validate(setup_.abu);
   validate(setup_.profile);
+  validate(setup_.motor);
+  validate(setup_.options);  // the reader's rules, from the one field list (simulation_config.hpp)
   const auto& o = setup_.options;
-  if (!(o.rtol > 0 && o.rtol < 1)) throw ConfigError("simulation.rtol", std::to_string(o.rtol), "must be in (0, 1)");
-  if (!(o.atol > 0)) throw ConfigError("simulation.atol", std::to_string(o.atol), "must be > 0");
-  if (o.end_time_s < 0) throw ConfigError("simulation.end_time_s", std::to_string(o.end_time_s), "must be >= 0 (0: twice the profile duration)");
   if (end_time_s() <= 0)
     throw ConfigError("simulation.end_time_s", std::to_string(o.end_time_s),
                       "must be > 0 when the profile has no segments");

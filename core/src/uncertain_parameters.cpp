@@ -27,6 +27,12 @@ std::string pair_text(double lo, double hi) {
   return os.str();
 }
 
+std::string pair_list_text(const std::vector<double>& v) {
+  std::string t = "[";
+  for (std::size_t i = 0; i < v.size(); ++i) t += (i ? ", " : "") + format_shortest(v[i]);
+  return t + "]";
+}
+
 double lerp(double lo, double hi, double u) { return lo + (hi - lo) * u; }
 
 }  // namespace
@@ -53,6 +59,7 @@ bool UncertainParameters::deterministic() const {
 }
 
 void validate(const UncertainParameters& u, const std::string& path) {
+  validate_fields(u, path);
   const std::string f = (path.empty() ? "" : path + ".") + "friction";
   const std::string im = (path.empty() ? "" : path + ".") + "imbalance";
   auto check_mu = [](const std::string& key, double v) {
@@ -108,52 +115,76 @@ RunOverrides sample_overrides(const UncertainParameters& u, const AbuParameters&
   return o;
 }
 
+const EnumNames<ImbalanceAngleSampling> kImbalanceAngleNames = {{ImbalanceAngleSampling::Fixed, "fixed"},
+                                                                 {ImbalanceAngleSampling::Uniform, "uniform"}};
+
+void describe_fields(FieldArchive& a, UncertainParameters& u) {
+  // friction: exactly one of {fixed: mu}, {list: [...]}, {range: [lo, hi]}; absent: nominal.
+  FrictionUncertainty& f = u.friction;
+  std::optional<double> fixed;
+  std::optional<std::vector<double>> list, range;
+  if (f.sampling == FrictionSampling::Fixed) fixed = f.value;
+  if (f.sampling == FrictionSampling::List) list = f.values;
+  if (f.sampling == FrictionSampling::Range) range = std::vector<double>{f.lo, f.hi};
+  const bool friction_given = a.reading() ? a.has("friction") : f.sampling != FrictionSampling::Nominal;
+  FieldOptions friction_options;
+  friction_options.enabled = a.reading() || friction_given;
+  a.section("friction", [&] {
+    if (YamlReader* r = a.reader()) {
+      if (int(r->has("fixed")) + int(r->has("list")) + int(r->has("range")) != 1)
+        throw ConfigError(r->path(), yaml_value_text(r->node()), "must have exactly one of: fixed, list, range");
+    }
+    // Reading accepts any one of them; the other archives see the one in use.
+    auto in_use = [&](FrictionSampling k) {
+      FieldOptions o;
+      o.enabled = a.reading() || f.sampling == k;
+      return o;
+    };
+    a.field("fixed", fixed, Rule::non_negative(), in_use(FrictionSampling::Fixed));
+    a.field("list", list, Rule::non_negative(), in_use(FrictionSampling::List));
+    a.field("range", range, Rule::non_negative(), in_use(FrictionSampling::Range));
+    if (a.reading() && range && range->size() != 2)
+      throw ConfigError(a.path("range"), pair_list_text(*range), "must be a list [lo, hi]");
+  }, friction_options);
+  // Back into the struct (a mirror of the keys; also when another archive changed them).
+  if (friction_given) {
+    if (fixed) {
+      f.sampling = FrictionSampling::Fixed;
+      f.value = *fixed;
+    } else if (list) {
+      f.sampling = FrictionSampling::List;
+      f.values = *list;
+    } else if (range && range->size() == 2) {
+      f.sampling = FrictionSampling::Range;
+      f.lo = (*range)[0];
+      f.hi = (*range)[1];
+    }
+  }
+
+  // imbalance: {mass_relative_range: [lo, hi], angle: fixed | uniform, angle_rad: 0}
+  std::optional<std::vector<double>> mass_range;
+  if (u.imbalance_mass.sampling == ImbalanceMassSampling::RelativeRange)
+    mass_range = std::vector<double>{u.imbalance_mass.relative_lo, u.imbalance_mass.relative_hi};
+  a.section("imbalance", [&] {
+    a.field("mass_relative_range", mass_range);
+    if (a.reading() && mass_range && mass_range->size() != 2)
+      throw ConfigError(a.path("mass_relative_range"), pair_list_text(*mass_range), "must be a list [lo, hi]");
+    a.field("angle", u.imbalance_angle.sampling, kImbalanceAngleNames);
+    a.field("angle_rad", u.imbalance_angle.angle_rad, Rule::any(),
+            FieldOptions::only_if(u.imbalance_angle.sampling == ImbalanceAngleSampling::Fixed,
+                                  "is only valid with angle: fixed (angle: uniform draws it)"));
+  });
+  if (mass_range && mass_range->size() == 2) {
+    u.imbalance_mass.sampling = ImbalanceMassSampling::RelativeRange;
+    u.imbalance_mass.relative_lo = (*mass_range)[0];
+    u.imbalance_mass.relative_hi = (*mass_range)[1];
+  }
+}
+
 UncertainParameters read_uncertain_parameters(YamlReader& mc) {
   UncertainParameters u;
-  YamlReader f = mc.child("friction");
-  if (f.present()) {
-    int given = int(f.has("fixed")) + int(f.has("list")) + int(f.has("range"));
-    if (given != 1)
-      throw ConfigError(f.path(), yaml_value_text(f.node()), "must have exactly one of: fixed, list, range");
-    if (f.has("fixed")) {
-      u.friction.sampling = FrictionSampling::Fixed;
-      u.friction.value = f.get_double("fixed", Rule::non_negative());
-    } else if (f.has("list")) {
-      u.friction.sampling = FrictionSampling::List;
-      u.friction.values = f.get_double_list("list", Rule::non_negative());
-    } else {
-      u.friction.sampling = FrictionSampling::Range;
-      auto r = f.get_double_list("range", Rule::non_negative());
-      if (r.size() != 2)
-        throw ConfigError(f.key_path("range"), yaml_value_text(f.node()["range"]), "must be a list [lo, hi]");
-      u.friction.lo = r[0];
-      u.friction.hi = r[1];
-    }
-    f.finish();
-  }
-  YamlReader im = mc.child("imbalance");
-  if (im.present()) {
-    if (im.has("mass_relative_range")) {
-      auto r = im.get_double_list("mass_relative_range");
-      if (r.size() != 2)
-        throw ConfigError(im.key_path("mass_relative_range"), yaml_value_text(im.node()["mass_relative_range"]),
-                          "must be a list [lo, hi]");
-      u.imbalance_mass.sampling = ImbalanceMassSampling::RelativeRange;
-      u.imbalance_mass.relative_lo = r[0];
-      u.imbalance_mass.relative_hi = r[1];
-    } else {
-      im.get_string_or("mass_relative_range", "");  // marks a null value as read
-    }
-    const std::string a = im.get_choice_or("angle", "fixed", {"fixed", "uniform"});
-    u.imbalance_angle.sampling = a == "uniform" ? ImbalanceAngleSampling::Uniform : ImbalanceAngleSampling::Fixed;
-    if (u.imbalance_angle.sampling == ImbalanceAngleSampling::Fixed) {
-      u.imbalance_angle.angle_rad = im.get_double_or("angle_rad", 0.0);
-    } else if (im.has("angle_rad")) {
-      throw ConfigError(im.key_path("angle_rad"), yaml_value_text(im.node()["angle_rad"]),
-                        "is only valid with angle: fixed (angle: uniform draws it)");
-    }
-    im.finish();
-  }
+  YamlReadArchive a(mc);
+  describe_fields(a, u);
   validate(u, mc.path());
   return u;
 }

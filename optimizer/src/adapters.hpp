@@ -10,14 +10,16 @@
 namespace abuopt::opt::detail {
 
 struct AdapterOutcome {
-  TerminationReason reason = TerminationReason::failure;
+  TerminationReason reason = TerminationReason::Failure;
   std::string message;
   std::string algorithm_label;  // e.g. "AUGLAG(BOBYQA)"
   long iterations = 0;
+  std::vector<IterationRecord> records;  // SAO
 };
 
 // `x0` in real units, inside the bounds. `local` is used for AUGLAG / MLSL_LDS and for wrapping a
-// bound-only local algorithm in AUGLAG (wrap == true).
+// bound-only local algorithm in AUGLAG (wrap == true); it may be null otherwise. An algorithm that
+// needs a local one without getting it is API misuse: std::invalid_argument.
 AdapterOutcome run_nlopt(EvaluationDriver& driver, const AlgorithmInfo& algorithm, const AlgorithmInfo* local,
                          bool wrap_in_auglag, const OptimizerOptions& options, const std::vector<double>& x0);
 

@@ -80,7 +80,7 @@ SolverSpec read_solver_spec(YamlReader& r) {
   s.options.algorithm = algorithm;
   YamlReader sao = r.child("sao");
   if (sao.present()) {
-    if (!is_sao_algorithm(algorithm))
+    if (find_algorithm(algorithm, r.key_path("algorithm")).name != "SAO")
       throw ConfigError(r.key_path("sao"), "<section>", "only for algorithm sao (this solver is " + algorithm + ")");
     s.options.sao = read_sao_options(sao);
   }
@@ -182,7 +182,7 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
   labels.clear();
   for (const SolverSpec& s : setup.solvers) {
     if (!labels.insert(s.label).second) throw ConfigError("compare.solvers", s.label, "duplicate solver label");
-    if (is_sao_algorithm(s.options.algorithm)) s.options.sao.validate("compare.solvers[" + s.label + "].sao");
+    if (find_algorithm(s.options.algorithm).name == "SAO") s.options.sao.validate("compare.solvers[" + s.label + "].sao");
     s.options.validate();
   }
 
@@ -214,7 +214,7 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
           // e.g. a bound-only global algorithm on a constrained problem: recorded as a failed run
           rec.result.problem_name = problem->name();
           rec.result.algorithm = o.algorithm;
-          rec.result.reason = TerminationReason::failure;
+          rec.result.reason = TerminationReason::Failure;
           rec.result.message = e.what();
         }
         double best = kInf;

@@ -62,7 +62,7 @@ EvaluationDriver::EvaluationDriver(Problem& problem, const OptimizerOptions& opt
   }
   const double eps = std::numeric_limits<double>::epsilon();
   fd_step_ = options.fd_relative_step > 0 ? options.fd_relative_step
-             : options.finite_difference == FiniteDifference::central ? std::cbrt(eps)
+             : options.finite_difference == FiniteDifference::Central ? std::cbrt(eps)
                                                                         : std::sqrt(eps);
 }
 
@@ -83,13 +83,13 @@ void EvaluationDriver::stop(TerminationReason reason, std::string message) {
 bool EvaluationDriver::check_limits() {
   if (stop_reason_) return true;
   if (interrupt_flag().load()) {
-    stop(TerminationReason::interrupted, "interrupted (SIGINT or request_stop) after " +
+    stop(TerminationReason::Interrupted, "interrupted (SIGINT or request_stop) after " +
                                              std::to_string(evaluations_) + " evaluations");
   } else if (evaluations_ >= options_.max_evaluations) {
-    stop(TerminationReason::max_evaluations,
+    stop(TerminationReason::MaxEvaluations,
          "evaluation budget of " + std::to_string(options_.max_evaluations) + " used up");
   } else if (options_.max_time_s > 0 && elapsed_s() >= options_.max_time_s) {
-    stop(TerminationReason::max_time, "time limit of " + format_number(options_.max_time_s) + " s reached");
+    stop(TerminationReason::MaxTime, "time limit of " + format_number(options_.max_time_s) + " s reached");
   }
   return stop_reason_.has_value();
 }
@@ -196,24 +196,24 @@ const EvaluatedPoint* EvaluationDriver::evaluate(const double* y, bool for_gradi
   rec.elapsed_s = elapsed_s();
   rec.message = stored.e.message;
 
-  if (threw) stop(TerminationReason::evaluation_error, stored.e.message + " (at evaluation " +
+  if (threw) stop(TerminationReason::EvaluationError, stored.e.message + " (at evaluation " +
                                                            std::to_string(rec.index) + ")");
   const EvaluatedPoint& best = points_[*best_];
   if (options_.target && best.feasible && best.e.objective <= *options_.target)
-    stop(TerminationReason::target_reached,
+    stop(TerminationReason::TargetReached,
          "a feasible point reached f = " + format_number(best.e.objective) + " <= target " +
              format_number(*options_.target));
   if (callback_) {
     Progress progress{rec, evaluations_, archive_hits_, rec.elapsed_s, best.feasible,
                       best.feasible ? best.e.objective : kInf};
     try {
-      if (!callback_(progress)) stop(TerminationReason::stopped_by_callback, "the callback asked to stop");
+      if (!callback_(progress)) stop(TerminationReason::StoppedByCallback, "the callback asked to stop");
     } catch (const std::exception& ex) {
-      stop(TerminationReason::stopped_by_callback, std::string("the callback threw: ") + ex.what());
+      stop(TerminationReason::StoppedByCallback, std::string("the callback threw: ") + ex.what());
     }
   }
   if (interrupt_flag().load())
-    stop(TerminationReason::interrupted,
+    stop(TerminationReason::Interrupted,
          "interrupted (SIGINT or request_stop) after " + std::to_string(evaluations_) + " evaluations");
   if (options_.keep_history) history_.push_back(std::move(rec));
   return &stored;
@@ -263,7 +263,7 @@ bool EvaluationDriver::derivatives(const double* y_in, const EvaluatedPoint& bas
     const bool room_up = y[j] + h <= upper_y_[j];
     const bool room_down = y[j] - h >= lower_y_[j];
     double up = 0, down = 0;
-    if (options_.finite_difference == FiniteDifference::central && room_up && room_down) {
+    if (options_.finite_difference == FiniteDifference::Central && room_up && room_down) {
       const EvaluatedPoint* a = neighbour(j, h, up);
       if (!a) return false;
       const EvaluatedPoint* b = neighbour(j, -h, down);

@@ -122,26 +122,26 @@ class DriverTnlp : public Ipopt::TNLP {
 AdapterOutcome map_status(Ipopt::ApplicationReturnStatus s) {
   using R = TerminationReason;
   switch (s) {
-    case Ipopt::Solve_Succeeded: return {R::converged, "Ipopt: optimal solution found", "", 0};
+    case Ipopt::Solve_Succeeded: return {R::Converged, "Ipopt: optimal solution found", "", 0, {}};
     case Ipopt::Solved_To_Acceptable_Level:
-      return {R::converged, "Ipopt: solved to an acceptable level (acceptable_tol)", "", 0};
-    case Ipopt::Infeasible_Problem_Detected: return {R::infeasible, "Ipopt: converged to a point of local infeasibility", "", 0};
+      return {R::Converged, "Ipopt: solved to an acceptable level (acceptable_tol)", "", 0, {}};
+    case Ipopt::Infeasible_Problem_Detected: return {R::Infeasible, "Ipopt: converged to a point of local infeasibility", "", 0, {}};
     case Ipopt::Search_Direction_Becomes_Too_Small:
-      return {R::converged_xtol, "Ipopt: search direction became too small", "", 0};
-    case Ipopt::Diverging_Iterates: return {R::failure, "Ipopt: iterates diverging", "", 0};
-    case Ipopt::User_Requested_Stop: return {R::stopped_by_callback, "Ipopt: stopped on request", "", 0};
-    case Ipopt::Feasible_Point_Found: return {R::converged, "Ipopt: feasible point found", "", 0};
-    case Ipopt::Maximum_Iterations_Exceeded: return {R::max_iterations, "Ipopt: maximum number of iterations", "", 0};
-    case Ipopt::Restoration_Failed: return {R::failure, "Ipopt: restoration phase failed", "", 0};
-    case Ipopt::Error_In_Step_Computation: return {R::failure, "Ipopt: error in step computation", "", 0};
-    case Ipopt::Maximum_CpuTime_Exceeded: return {R::max_time, "Ipopt: maximum CPU time exceeded", "", 0};
+      return {R::ConvergedXtol, "Ipopt: search direction became too small", "", 0, {}};
+    case Ipopt::Diverging_Iterates: return {R::Failure, "Ipopt: iterates diverging", "", 0, {}};
+    case Ipopt::User_Requested_Stop: return {R::StoppedByCallback, "Ipopt: stopped on request", "", 0, {}};
+    case Ipopt::Feasible_Point_Found: return {R::Converged, "Ipopt: feasible point found", "", 0, {}};
+    case Ipopt::Maximum_Iterations_Exceeded: return {R::MaxIterations, "Ipopt: maximum number of iterations", "", 0, {}};
+    case Ipopt::Restoration_Failed: return {R::Failure, "Ipopt: restoration phase failed", "", 0, {}};
+    case Ipopt::Error_In_Step_Computation: return {R::Failure, "Ipopt: error in step computation", "", 0, {}};
+    case Ipopt::Maximum_CpuTime_Exceeded: return {R::MaxTime, "Ipopt: maximum CPU time exceeded", "", 0, {}};
     case Ipopt::Not_Enough_Degrees_Of_Freedom:
-      return {R::failure, "Ipopt: not enough degrees of freedom (more equality constraints than variables?)", "", 0};
-    case Ipopt::Invalid_Problem_Definition: return {R::failure, "Ipopt: invalid problem definition", "", 0};
-    case Ipopt::Invalid_Option: return {R::failure, "Ipopt: invalid option", "", 0};
+      return {R::Failure, "Ipopt: not enough degrees of freedom (more equality constraints than variables?)", "", 0, {}};
+    case Ipopt::Invalid_Problem_Definition: return {R::Failure, "Ipopt: invalid problem definition", "", 0, {}};
+    case Ipopt::Invalid_Option: return {R::Failure, "Ipopt: invalid option", "", 0, {}};
     case Ipopt::Invalid_Number_Detected:
-      return {R::failure, "Ipopt: invalid number (NaN/inf) in the problem functions", "", 0};
-    default: return {R::failure, "Ipopt: internal error (status " + std::to_string(static_cast<int>(s)) + ")", "", 0};
+      return {R::Failure, "Ipopt: invalid number (NaN/inf) in the problem functions", "", 0, {}};
+    default: return {R::Failure, "Ipopt: internal error (status " + std::to_string(static_cast<int>(s)) + ")", "", 0, {}};
   }
 }
 
@@ -166,7 +166,7 @@ AdapterOutcome run_ipopt(EvaluationDriver& d, const OptimizerOptions& options, c
   out.algorithm_label = "IPOPT";
   Ipopt::ApplicationReturnStatus status = app->Initialize("");
   if (status != Ipopt::Solve_Succeeded) {
-    out.reason = TerminationReason::failure;
+    out.reason = TerminationReason::Failure;
     out.message = "Ipopt failed to initialise (status " + std::to_string(static_cast<int>(status)) + ")";
     return out;
   }
@@ -175,7 +175,7 @@ AdapterOutcome run_ipopt(EvaluationDriver& d, const OptimizerOptions& options, c
   mapped.algorithm_label = out.algorithm_label;
   mapped.iterations = tnlp->iterations;
   if (status == Ipopt::User_Requested_Stop && tnlp->stalled) {
-    mapped.reason = TerminationReason::converged_xtol;
+    mapped.reason = TerminationReason::ConvergedXtol;
     mapped.message = "Ipopt stopped: no new point in " + std::to_string(DriverTnlp::kStallIterations) +
                      " iterations (finite-difference noise above its tolerance)";
   }

@@ -37,7 +37,7 @@ OptimizationResult minimize(Problem& problem, const OptimizerOptions& options, s
     const std::string what = needs_ineq && needs_eq ? "inequality and equality constraints"
                              : needs_ineq           ? count_text(m_ineq, "inequality constraint")
                                                     : count_text(m_eq, "equality constraint");
-    if (algorithm.family == AlgorithmFamily::global)
+    if (algorithm.family == AlgorithmFamily::Global)
       throw ConfigError("optimizer.algorithm", options.algorithm,
                         "the global algorithm " + algorithm.name + " handles bounds only and problem '" +
                             problem.name() + "' has " + what +
@@ -73,7 +73,7 @@ OptimizationResult minimize(Problem& problem, const OptimizerOptions& options, s
     else
       outcome = detail::run_nlopt(driver, algorithm, local, wrap, options, x0);
   } catch (const std::exception& ex) {
-    outcome.reason = TerminationReason::failure;
+    outcome.reason = TerminationReason::Failure;
     outcome.message = std::string("the optimiser threw: ") + ex.what();
   }
 
@@ -82,6 +82,7 @@ OptimizationResult minimize(Problem& problem, const OptimizerOptions& options, s
   r.algorithm = outcome.algorithm_label;
   r.x0 = x0;
   r.iterations = outcome.iterations;
+  r.iteration_records = std::move(outcome.records);
   for (const Variable& v : problem.variables()) r.variable_names.push_back(v.name);
   r.inequality_names = problem.inequality_names();
   r.equality_names = problem.equality_names();
@@ -100,7 +101,7 @@ OptimizationResult minimize(Problem& problem, const OptimizerOptions& options, s
                 ") but no evaluated point is feasible within the tolerance " +
                 format_number(options.constraint_tolerance) +
                 (r.x.empty() ? "" : " (smallest violation " + format_number(r.max_violation) + ")");
-    r.reason = TerminationReason::infeasible;
+    r.reason = TerminationReason::Infeasible;
   }
   if (detail::interrupt_flag().load()) detail::interrupt_flag().store(false);
   return r;

@@ -98,22 +98,22 @@ void set_tolerances(nlopt_opt o, const OptimizerOptions& options, const Evaluati
 AdapterOutcome map_result(nlopt_result r, EvaluationDriver& d) {
   AdapterOutcome out;
   switch (r) {
-    case NLOPT_SUCCESS: out = {TerminationReason::converged, "NLopt: success", "", 0}; break;
-    case NLOPT_STOPVAL_REACHED: out = {TerminationReason::target_reached, "NLopt: stopval reached", "", 0}; break;
-    case NLOPT_FTOL_REACHED: out = {TerminationReason::converged_ftol, "NLopt: ftol_rel or ftol_abs reached", "", 0}; break;
-    case NLOPT_XTOL_REACHED: out = {TerminationReason::converged_xtol, "NLopt: xtol_rel reached", "", 0}; break;
+    case NLOPT_SUCCESS: out = {TerminationReason::Converged, "NLopt: success", "", 0, {}}; break;
+    case NLOPT_STOPVAL_REACHED: out = {TerminationReason::TargetReached, "NLopt: stopval reached", "", 0, {}}; break;
+    case NLOPT_FTOL_REACHED: out = {TerminationReason::ConvergedFtol, "NLopt: ftol_rel or ftol_abs reached", "", 0, {}}; break;
+    case NLOPT_XTOL_REACHED: out = {TerminationReason::ConvergedXtol, "NLopt: xtol_rel reached", "", 0, {}}; break;
     case NLOPT_MAXEVAL_REACHED:
-      out = {TerminationReason::max_evaluations,
-             "NLopt's own call limit (10 x max_evaluations + 100, counting repeated points) reached", "", 0};
+      out = {TerminationReason::MaxEvaluations,
+             "NLopt's own call limit (10 x max_evaluations + 100, counting repeated points) reached", "", 0, {}};
       break;
-    case NLOPT_MAXTIME_REACHED: out = {TerminationReason::max_time, "NLopt: maxtime reached", "", 0}; break;
-    case NLOPT_FORCED_STOP: out = {TerminationReason::failure, "NLopt: forced stop", "", 0}; break;
+    case NLOPT_MAXTIME_REACHED: out = {TerminationReason::MaxTime, "NLopt: maxtime reached", "", 0, {}}; break;
+    case NLOPT_FORCED_STOP: out = {TerminationReason::Failure, "NLopt: forced stop", "", 0, {}}; break;
     case NLOPT_ROUNDOFF_LIMITED:
-      out = {TerminationReason::roundoff_limited, "NLopt: roundoff errors limited progress", "", 0};
+      out = {TerminationReason::RoundoffLimited, "NLopt: roundoff errors limited progress", "", 0, {}};
       break;
-    case NLOPT_OUT_OF_MEMORY: out = {TerminationReason::failure, "NLopt: out of memory", "", 0}; break;
-    case NLOPT_INVALID_ARGS: out = {TerminationReason::failure, "NLopt: invalid arguments", "", 0}; break;
-    default: out = {TerminationReason::failure, "NLopt: failure", "", 0}; break;
+    case NLOPT_OUT_OF_MEMORY: out = {TerminationReason::Failure, "NLopt: out of memory", "", 0, {}}; break;
+    case NLOPT_INVALID_ARGS: out = {TerminationReason::Failure, "NLopt: invalid arguments", "", 0, {}}; break;
+    default: out = {TerminationReason::Failure, "NLopt: failure", "", 0, {}}; break;
   }
   (void)d;
   return out;
@@ -125,7 +125,11 @@ AdapterOutcome run_nlopt(EvaluationDriver& d, const AlgorithmInfo& algorithm, co
                          bool wrap_in_auglag, const OptimizerOptions& options, const std::vector<double>& x0) {
   const unsigned n = static_cast<unsigned>(d.n());
   const bool uses_local = wrap_in_auglag || algorithm.needs_local;
-  const AlgorithmInfo& inner = wrap_in_auglag ? algorithm : *local;
+  // the algorithm that solves AUGLAG's / MLSL's sub-problems (none for a plain run: never bind a
+  // reference to *local then, local is null)
+  const AlgorithmInfo* inner = wrap_in_auglag ? &algorithm : local;
+  if (uses_local && !inner)
+    throw std::invalid_argument("run_nlopt: " + algorithm.name + " needs a local algorithm and none was given");
 
   nlopt_algorithm outer_code = nlopt_code(algorithm.name);
   std::string label = algorithm.name;
@@ -141,7 +145,8 @@ AdapterOutcome run_nlopt(EvaluationDriver& d, const AlgorithmInfo& algorithm, co
   if (!opt) throw std::runtime_error("nlopt_create failed for " + label);
   OptPtr local_opt;
   if (uses_local) {
-    local_opt.reset(nlopt_create(nlopt_code(inner.name), n));
+    local_opt.reset(nlopt_create(nlopt_code(inner->name), n));
+    if (!local_opt) throw std::runtime_error("nlopt_create failed for " + inner->name);
     set_tolerances(local_opt.get(), options, d);
   }
 

@@ -14,19 +14,19 @@ namespace {
 const std::vector<std::pair<TerminationReason, const char*>>& reason_names() {
   using R = TerminationReason;
   static const std::vector<std::pair<R, const char*>> names = {
-      {R::converged, "converged"},
-      {R::converged_ftol, "converged_ftol"},
-      {R::converged_xtol, "converged_xtol"},
-      {R::target_reached, "target_reached"},
-      {R::max_evaluations, "max_evaluations"},
-      {R::max_iterations, "max_iterations"},
-      {R::max_time, "max_time"},
-      {R::stopped_by_callback, "stopped_by_callback"},
-      {R::interrupted, "interrupted"},
-      {R::evaluation_error, "evaluation_error"},
-      {R::infeasible, "infeasible"},
-      {R::roundoff_limited, "roundoff_limited"},
-      {R::failure, "failure"},
+      {R::Converged, "converged"},
+      {R::ConvergedFtol, "converged_ftol"},
+      {R::ConvergedXtol, "converged_xtol"},
+      {R::TargetReached, "target_reached"},
+      {R::MaxEvaluations, "max_evaluations"},
+      {R::MaxIterations, "max_iterations"},
+      {R::MaxTime, "max_time"},
+      {R::StoppedByCallback, "stopped_by_callback"},
+      {R::Interrupted, "interrupted"},
+      {R::EvaluationError, "evaluation_error"},
+      {R::Infeasible, "infeasible"},
+      {R::RoundoffLimited, "roundoff_limited"},
+      {R::Failure, "failure"},
   };
   return names;
 }
@@ -54,9 +54,19 @@ TerminationReason termination_reason_from_string(const std::string& text) {
   throw ConfigError("termination reason", text, "unknown; valid: " + valid);
 }
 
+std::string to_string(IterationStep step) {
+  switch (step) {
+    case IterationStep::Accepted: return "accepted";
+    case IterationStep::Rejected: return "rejected";
+    case IterationStep::NoPredictedReduction: return "no_predicted_reduction";
+    case IterationStep::NoModel: return "no_model";
+  }
+  return "unknown";
+}
+
 bool is_convergence(TerminationReason r) {
-  return r == TerminationReason::converged || r == TerminationReason::converged_ftol ||
-         r == TerminationReason::converged_xtol || r == TerminationReason::target_reached;
+  return r == TerminationReason::Converged || r == TerminationReason::ConvergedFtol ||
+         r == TerminationReason::ConvergedXtol || r == TerminationReason::TargetReached;
 }
 
 bool OptimizationResult::success() const { return is_convergence(reason) && has_feasible_point(); }

@@ -9,7 +9,13 @@
 namespace abuopt::opt {
 
 std::string to_string(FiniteDifference kind) {
-  return kind == FiniteDifference::central ? "central" : "forward";
+  return kind == FiniteDifference::Central ? "central" : "forward";
+}
+
+FiniteDifference finite_difference_from_string(const std::string& text, const std::string& key) {
+  if (text == "forward") return FiniteDifference::Forward;
+  if (text == "central") return FiniteDifference::Central;
+  throw ConfigError(key, text.empty() ? "\"\"" : text, "must be one of: forward, central");
 }
 
 namespace {
@@ -22,7 +28,7 @@ void OptimizerOptions::validate() const {
   const AlgorithmInfo& info = find_algorithm(algorithm, "optimizer.algorithm");
   if (!local_algorithm.empty()) {
     const AlgorithmInfo& local = find_algorithm(local_algorithm, "optimizer.local_algorithm");
-    if (local.family != AlgorithmFamily::local_derivative_free && local.family != AlgorithmFamily::local_gradient)
+    if (local.family != AlgorithmFamily::LocalDerivativeFree && local.family != AlgorithmFamily::LocalGradient)
       throw ConfigError("optimizer.local_algorithm", local_algorithm, "must be a local algorithm (not global or AUGLAG)");
     if (local.name == "IPOPT" || local.name == "SAO")
       throw ConfigError("optimizer.local_algorithm", local_algorithm,
@@ -61,9 +67,9 @@ OptimizerOptions read_optimizer_options(YamlReader& r, YamlReader* sao_section) 
   if (r.has("target")) o.target = r.get_double("target");
   else r.get_double_or("target", 0.0);  // marks an explicit `target: null` as read
   o.constraint_tolerance = r.get_double_or("constraint_tolerance", o.constraint_tolerance, Rule::non_negative());
-  o.finite_difference =
-      r.get_choice_or("finite_difference", "forward", {"forward", "central"}) == "central" ? FiniteDifference::central
-                                                                                          : FiniteDifference::forward;
+  o.finite_difference = finite_difference_from_string(
+      r.get_choice_or("finite_difference", to_string(o.finite_difference), {"forward", "central"}),
+      r.key_path("finite_difference"));
   o.fd_relative_step = r.get_double_or("fd_relative_step", o.fd_relative_step, Rule::in_range(0.0, 0.49));
   o.seed = static_cast<unsigned long>(r.get_int_or("seed", static_cast<long>(o.seed), Rule::non_negative()));
   o.population = r.get_int_or("population", o.population, Rule::non_negative());

@@ -30,11 +30,6 @@ const std::vector<double>& exponent_grid() {
 
 }  // namespace
 
-const std::vector<std::string>& intervening_choices() {
-  static const std::vector<std::string> c = {"auto", "linear", "reciprocal", "exponential"};
-  return c;
-}
-
 bool intervening_allowed(double lower, double upper) {
   return std::isfinite(lower) && std::isfinite(upper) && lower > 0 && upper >= lower;
 }
@@ -160,7 +155,7 @@ Candidate fit_candidate(const InterveningData& data, const Eigen::VectorXd& y, c
     model->fit(data.S, y, data.weights);
     c.error = weighted_press(static_cast<const surrogate::ResponseSurface&>(model->inner()), data.weights);
     c.model = std::move(model);
-  } catch (const std::invalid_argument&) {
+  } catch (const surrogate::InsufficientData&) {
     c.error = kInf;
   }
   return c;
@@ -173,7 +168,7 @@ double error_of(const InterveningData& data, const Eigen::VectorXd& y, const Eig
 
 }  // namespace
 
-InterveningChoice fit_intervening(const std::string& requested, surrogate::Basis basis, const InterveningData& data,
+InterveningChoice fit_intervening(InterveningKind requested, surrogate::Basis basis, const InterveningData& data,
                                   const Eigen::VectorXd& y, const InterveningChoice* previous) {
   const int n = static_cast<int>(data.S.cols());
   const bool any_allowed = std::find(data.allowed.begin(), data.allowed.end(), true) != data.allowed.end();
@@ -183,8 +178,8 @@ InterveningChoice fit_intervening(const std::string& requested, surrogate::Basis
     if (data.allowed[i]) reciprocal[i] = -1.0;
 
   // the final fit with `basis`; a transformed fit that fails falls back to the linear form
-  auto finish = [&](const std::string& form, const Eigen::VectorXd& p) {
-    Candidate c = fit_candidate(data, y, p, basis, form);
+  auto finish = [&](InterveningKind form, const Eigen::VectorXd& p) {
+    Candidate c = fit_candidate(data, y, p, basis, to_string(form));
     InterveningChoice out;
     if (!c.model) {
       c = fit_candidate(data, y, ones, basis, "linear");
@@ -192,9 +187,9 @@ InterveningChoice fit_intervening(const std::string& requested, surrogate::Basis
         // let the response surface say why (too few points, rank-deficient)
         surrogate::ResponseSurface rs(basis);
         rs.fit(data.S, y, data.weights);
-        throw std::invalid_argument("the " + surrogate::to_string(basis) + " surrogate could not be fitted");
+        throw surrogate::InsufficientData("the " + surrogate::to_string(basis) + " surrogate could not be fitted");
       }
-      out.form = "linear";
+      out.form = InterveningKind::Linear;
       out.exponents = ones;
     } else {
       out.form = form;
@@ -205,11 +200,8 @@ InterveningChoice fit_intervening(const std::string& requested, surrogate::Basis
     return out;
   };
 
-  if (requested == "linear" || !any_allowed) return finish("linear", ones);
-  if (requested == "reciprocal") return finish("reciprocal", reciprocal);
-  if (requested != "exponential" && requested != "auto")
-    throw std::invalid_argument("intervening form \"" + requested + "\": must be one of auto, linear, reciprocal, "
-                                "exponential");
+  if (requested == InterveningKind::Linear || !any_allowed) return finish(InterveningKind::Linear, ones);
+  if (requested == InterveningKind::Reciprocal) return finish(InterveningKind::Reciprocal, reciprocal);
 
   // the forms are compared by the leave-one-out error of a LINEAR model in their variables (the
   // form in which the response is most nearly linear): the comparison with the most points to
@@ -219,9 +211,10 @@ InterveningChoice fit_intervening(const std::string& requested, surrogate::Basis
   const double e_reciprocal = error_of(data, y, reciprocal, selection);
   if (!std::isfinite(e_linear) && !std::isfinite(e_reciprocal)) {
     // nothing to compare with: keep this response's previous choice
-    if (previous && previous->exponents.size() == n && (requested == "auto" || previous->form == "exponential"))
+    if (previous && previous->exponents.size() == n &&
+        (requested == InterveningKind::Auto || previous->form == InterveningKind::Exponential))
       return finish(previous->form, previous->exponents);
-    return finish("linear", ones);
+    return finish(InterveningKind::Linear, ones);
   }
 
   double mean = 0, wsum = 0;
@@ -258,19 +251,19 @@ InterveningChoice fit_intervening(const std::string& requested, surrogate::Basis
     }
     if (!changed) break;
   }
-  if (requested == "exponential") return finish("exponential", p);
+  if (requested == InterveningKind::Exponential) return finish(InterveningKind::Exponential, p);
 
   // auto: linear unless a transformed form predicts the left-out points better
-  std::string form = "linear";
+  InterveningKind form = InterveningKind::Linear;
   Eigen::VectorXd chosen = ones;
   double best = e_linear;
   if (below(e_reciprocal, kReciprocalMargin, e_linear)) {
-    form = "reciprocal";
+    form = InterveningKind::Reciprocal;
     chosen = reciprocal;
     best = e_reciprocal;
   }
   if (below(e_exponential, kExponentialMargin, best)) {
-    form = "exponential";
+    form = InterveningKind::Exponential;
     chosen = p;
   }
   return finish(form, chosen);

@@ -7,7 +7,6 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/optimizer/problem.hpp"
-#include "abuopt/optimizer/sao_intervening.hpp"
 
 namespace abuopt::opt {
 
@@ -16,46 +15,68 @@ namespace abuopt::opt {
 
 namespace {
 
-const std::vector<std::string>& surrogate_choices() {
-  static const std::vector<std::string> c = {"auto", "linear", "interactions", "pure_quadratic", "quadratic",
-                                             "kriging"};
-  return c;
-}
-const std::vector<std::string>& doe_choices() {
-  static const std::vector<std::string> c = {"auto", "koshal", "axial", "central_composite", "lhs"};
-  return c;
-}
-const std::vector<std::string>& solver_choices() {
-  static const std::vector<std::string> c = {"slsqp", "cobyla"};
-  return c;
-}
-
 std::string join(const std::vector<std::string>& v) {
   std::string s;
   for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
   return s;
 }
 
+// The enumerator whose spelling is `text` (names in declaration order).
+template <class E>
+E enum_from_string(const std::string& text, const std::string& key, const std::vector<std::string>& names) {
+  const auto it = std::find(names.begin(), names.end(), text);
+  if (it == names.end())
+    throw ConfigError(key, text.empty() ? "\"\"" : text, "must be one of: " + join(names));
+  return static_cast<E>(it - names.begin());
+}
+template <class E>
+const std::string& enum_to_string(E value, const std::vector<std::string>& names) {
+  return names.at(static_cast<std::size_t>(value));
+}
+
 void require(bool ok, const std::string& prefix, const std::string& key, double value, const std::string& rule) {
   if (!ok) throw ConfigError(prefix + "." + key, format_number(value), rule);
-}
-void require_choice(const std::string& prefix, const std::string& key, const std::string& value,
-                    const std::vector<std::string>& choices) {
-  if (std::find(choices.begin(), choices.end(), value) == choices.end())
-    throw ConfigError(prefix + "." + key, value.empty() ? "\"\"" : value, "must be one of: " + join(choices));
 }
 
 }  // namespace
 
+const std::vector<std::string>& surrogate_kind_names() {
+  static const std::vector<std::string> c = {"auto", "linear", "interactions", "pure_quadratic", "quadratic",
+                                             "kriging"};
+  return c;
+}
+const std::vector<std::string>& doe_kind_names() {
+  static const std::vector<std::string> c = {"auto", "koshal", "axial", "central_composite", "lhs"};
+  return c;
+}
+const std::vector<std::string>& intervening_kind_names() {
+  static const std::vector<std::string> c = {"auto", "linear", "reciprocal", "exponential"};
+  return c;
+}
+const std::vector<std::string>& subproblem_solver_names() {
+  static const std::vector<std::string> c = {"slsqp", "cobyla"};
+  return c;
+}
+
+std::string to_string(SurrogateKind kind) { return enum_to_string(kind, surrogate_kind_names()); }
+std::string to_string(DoeKind kind) { return enum_to_string(kind, doe_kind_names()); }
+std::string to_string(InterveningKind kind) { return enum_to_string(kind, intervening_kind_names()); }
+std::string to_string(SubproblemSolver solver) { return enum_to_string(solver, subproblem_solver_names()); }
+
+SurrogateKind surrogate_kind_from_string(const std::string& text, const std::string& key) {
+  return enum_from_string<SurrogateKind>(text, key, surrogate_kind_names());
+}
+DoeKind doe_kind_from_string(const std::string& text, const std::string& key) {
+  return enum_from_string<DoeKind>(text, key, doe_kind_names());
+}
+InterveningKind intervening_kind_from_string(const std::string& text, const std::string& key) {
+  return enum_from_string<InterveningKind>(text, key, intervening_kind_names());
+}
+SubproblemSolver subproblem_solver_from_string(const std::string& text, const std::string& key) {
+  return enum_from_string<SubproblemSolver>(text, key, subproblem_solver_names());
+}
+
 void SaoOptions::validate(const std::string& p) const {
-  require_choice(p, "surrogate", surrogate, surrogate_choices());
-  require_choice(p, "doe", doe, doe_choices());
-  require_choice(p, "subproblem_solver", subproblem_solver, solver_choices());
-  require_choice(p, "intervening", intervening, intervening_choices());
-  if (!intervening_objective.empty())
-    require_choice(p, "intervening_objective", intervening_objective, intervening_choices());
-  if (!intervening_constraints.empty())
-    require_choice(p, "intervening_constraints", intervening_constraints, intervening_choices());
   require(doe_points >= 0, p, "doe_points", doe_points, "must be >= 0 (0: automatic)");
   require(std::isfinite(doe_points_factor) && doe_points_factor >= 1 && doe_points_factor <= 10, p,
           "doe_points_factor", doe_points_factor, "must be in [1, 10]");
@@ -96,15 +117,20 @@ void SaoOptions::validate(const std::string& p) const {
           "must be >= 10");
   require(std::isfinite(kriging_nugget) && kriging_nugget > 0 && kriging_nugget < 1, p, "kriging_nugget",
           kriging_nugget, "must be in (0, 1)");
-  if (surrogate == "quadratic" && doe == "koshal")
-    throw ConfigError(p + ".doe", doe, "koshal (n+1 points) cannot determine a quadratic surrogate; use auto, axial, "
+  if (surrogate == SurrogateKind::Quadratic && doe == DoeKind::Koshal)
+    throw ConfigError(p + ".doe", to_string(doe), "koshal (n+1 points) cannot determine a quadratic surrogate; use auto, axial, "
                                        "central_composite or lhs");
 }
 
 SaoOptions read_sao_options(YamlReader& r) {
   SaoOptions o;
-  o.surrogate = r.get_choice_or("surrogate", o.surrogate, surrogate_choices());
-  o.doe = r.get_choice_or("doe", o.doe, doe_choices());
+  // the choices: read as text (the reader checks the spelling), parsed once into their enums
+  auto choice = [&r](const std::string& key, const std::string& fallback, const std::vector<std::string>& names) {
+    return r.get_choice_or(key, fallback, names);
+  };
+  o.surrogate = surrogate_kind_from_string(choice("surrogate", to_string(o.surrogate), surrogate_kind_names()),
+                                           r.key_path("surrogate"));
+  o.doe = doe_kind_from_string(choice("doe", to_string(o.doe), doe_kind_names()), r.key_path("doe"));
   o.doe_points = static_cast<int>(r.get_int_or("doe_points", o.doe_points, Rule::in_range(0, 100000)));
   o.doe_points_factor = r.get_double_or("doe_points_factor", o.doe_points_factor);
   o.reuse_distance = r.get_double_or("reuse_distance", o.reuse_distance);
@@ -118,11 +144,14 @@ SaoOptions read_sao_options(YamlReader& r) {
   o.rho_shrink = r.get_double_or("rho_shrink", o.rho_shrink);
   o.rho_expand_low = r.get_double_or("rho_expand_low", o.rho_expand_low);
   o.rho_expand_high = r.get_double_or("rho_expand_high", o.rho_expand_high);
-  o.intervening = r.get_choice_or("intervening", o.intervening, intervening_choices());
-  o.intervening_objective = r.get_choice_or("intervening_objective", o.intervening, intervening_choices());
-  o.intervening_constraints = r.get_choice_or("intervening_constraints", o.intervening, intervening_choices());
-  if (o.intervening_objective == o.intervening) o.intervening_objective.clear();
-  if (o.intervening_constraints == o.intervening) o.intervening_constraints.clear();
+  o.intervening = intervening_kind_from_string(
+      choice("intervening", to_string(o.intervening), intervening_kind_names()), r.key_path("intervening"));
+  for (const char* key : {"intervening_objective", "intervening_constraints"}) {
+    if (!r.has(key)) continue;
+    const InterveningKind k = intervening_kind_from_string(
+        choice(key, to_string(o.intervening), intervening_kind_names()), r.key_path(key));
+    (std::string(key) == "intervening_objective" ? o.intervening_objective : o.intervening_constraints) = k;
+  }
   o.correction = r.get_bool_or("correction", o.correction);
   o.short_step = r.get_double_or("short_step", o.short_step);
   o.noise_tolerance = r.get_double_or("noise_tolerance", o.noise_tolerance);
@@ -130,7 +159,9 @@ SaoOptions read_sao_options(YamlReader& r) {
   o.penalty_multiplier_factor = r.get_double_or("penalty_multiplier_factor", o.penalty_multiplier_factor);
   o.stall_iterations = static_cast<int>(r.get_int_or("stall_iterations", o.stall_iterations, Rule::in_range(1, 1e6)));
   o.stall_tolerance = r.get_double_or("stall_tolerance", o.stall_tolerance);
-  o.subproblem_solver = r.get_choice_or("subproblem_solver", o.subproblem_solver, solver_choices());
+  o.subproblem_solver = subproblem_solver_from_string(
+      choice("subproblem_solver", to_string(o.subproblem_solver), subproblem_solver_names()),
+      r.key_path("subproblem_solver"));
   o.subproblem_max_evaluations = static_cast<int>(
       r.get_int_or("subproblem_max_evaluations", o.subproblem_max_evaluations, Rule::in_range(10, 1e7)));
   o.kriging_nugget = r.get_double_or("kriging_nugget", o.kriging_nugget);

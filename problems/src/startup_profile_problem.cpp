@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -28,36 +29,6 @@ std::string list_text(const std::vector<double>& v) {
 }
 
 std::string segment_path(std::size_t i) { return "design.segments[" + std::to_string(i) + "]"; }
-
-// A segment value: a number (fixed), a mapping {min, max, x0, scale} (free), or absent (fixed at
-// the template's value when the template has this segment).
-DesignValue read_design_value(YamlReader& seg, const std::string& key, std::optional<double> template_value,
-                              std::size_t index) {
-  DesignValue v;
-  if (!seg.has(key)) {
-    if (!template_value)
-      throw ConfigError(seg.key_path(key), "<missing>",
-                        "is required (the profile template has no segment " + std::to_string(index) + ")");
-    v.value = *template_value;
-    return v;
-  }
-  const YAML::Node& n = seg.node();
-  if (n[key].IsMap()) {
-    YamlReader m = seg.child(key);
-    v.free = true;
-    v.lower = m.get_double("min");
-    v.upper = m.get_double("max");
-    const double fallback = (template_value && *template_value >= v.lower && *template_value <= v.upper)
-                                ? *template_value
-                                : 0.5 * (v.lower + v.upper);
-    v.value = m.get_double_or("x0", fallback);
-    v.scale = m.get_double_or("scale", 0.0, Rule::positive());
-    m.finish();
-    return v;
-  }
-  v.value = seg.get_double(key);
-  return v;
-}
 
 void check_value(const DesignValue& v, const std::string& path, bool duration) {
   const std::string kind = duration ? "a duration" : "a frequency";
@@ -84,50 +55,18 @@ void check_value(const DesignValue& v, const std::string& path, bool duration) {
   if (v.scale < 0 || !std::isfinite(v.scale)) throw ConfigError(path + ".scale", format_number(v.scale), "must be > 0");
 }
 
-InitialConditionKind kind_of(const std::string& s, const std::string& path) {
-  return initial_condition_kind_from_string(s, path);
-}
-
-void append_value(std::ostringstream& os, const std::string& name, const DesignValue& v) {
-  if (v.free)
-    os << "  " << name << ": free\n";
-  else
-    os << "  " << name << ": " << format_number(v.value) << "\n";
-}
-
-std::string uncertain_text(const UncertainParameters& u) {
-  std::ostringstream os;
-  os << "friction: " << to_string(u.friction.sampling);
-  switch (u.friction.sampling) {
-    case FrictionSampling::Nominal: break;
-    case FrictionSampling::Fixed: os << " " << format_number(u.friction.value); break;
-    case FrictionSampling::List: os << " " << list_text(u.friction.values); break;
-    case FrictionSampling::Range:
-      os << " [" << format_number(u.friction.lo) << ", " << format_number(u.friction.hi) << "]";
-      break;
-  }
-  os << "\nimbalance_mass: " << to_string(u.imbalance_mass.sampling);
-  if (u.imbalance_mass.sampling == ImbalanceMassSampling::RelativeRange)
-    os << " [" << format_number(u.imbalance_mass.relative_lo) << ", " << format_number(u.imbalance_mass.relative_hi)
-       << "]";
-  os << "\nimbalance_angle: " << to_string(u.imbalance_angle.sampling);
-  if (u.imbalance_angle.sampling == ImbalanceAngleSampling::Fixed) os << " " << format_number(u.imbalance_angle.angle_rad);
-  os << "\n";
-  return os.str();
-}
-
 }  // namespace
 
-std::string to_string(ObjectiveKind k) {
-  switch (k) {
-    case ObjectiveKind::mean: return "mean";
-    case ObjectiveKind::pct_mi: return "pct_mi";
-    case ObjectiveKind::weighted: return "weighted";
-  }
-  return "?";
-}
-std::string to_string(ImbalanceDefinition d) { return d == ImbalanceDefinition::magnitude ? "magnitude" : "report_x"; }
-std::string to_string(AmplitudeStatistic a) { return a == AmplitudeStatistic::max ? "max" : "mean"; }
+const EnumNames<ObjectiveKind> kObjectiveKindNames = {
+    {ObjectiveKind::Mean, "mean"}, {ObjectiveKind::PctMi, "pct_mi"}, {ObjectiveKind::Weighted, "weighted"}};
+const EnumNames<ImbalanceDefinition> kImbalanceDefinitionNames = {{ImbalanceDefinition::Magnitude, "magnitude"},
+                                                                  {ImbalanceDefinition::ReportX, "report_x"}};
+const EnumNames<AmplitudeStatistic> kAmplitudeStatisticNames = {{AmplitudeStatistic::Max, "max"},
+                                                                {AmplitudeStatistic::Mean, "mean"}};
+
+std::string to_string(ObjectiveKind k) { return enum_name(kObjectiveKindNames, k); }
+std::string to_string(ImbalanceDefinition d) { return enum_name(kImbalanceDefinitionNames, d); }
+std::string to_string(AmplitudeStatistic a) { return enum_name(kAmplitudeStatisticNames, a); }
 
 std::uint64_t fnv1a64(std::string_view text) {
   std::uint64_t h = 14695981039346656037ull;
@@ -138,106 +77,144 @@ std::uint64_t fnv1a64(std::string_view text) {
   return h;
 }
 
+// ---- The field lists --------------------------------------------------------------------------
+
+namespace {
+
+// A segment value: a number (fixed), a mapping {min, max, x0, scale} (free), or absent (the
+// template's value, pre-filled by the list's resize; NaN when the template has no such segment).
+void describe_design_value(FieldArchive& a, const char* key, DesignValue& v, std::size_t index) {
+  a.number_or_section(key, v.free, v.value, Rule::any(), [&] {
+    a.field("min", v.lower, Rule::any(), FieldOptions::required_key().without_identity());
+    a.field("max", v.upper, Rule::any(), FieldOptions::required_key().without_identity());
+    if (a.reading() && !a.has("x0")) {  // default start: the template's value if inside the bounds
+      const double t = v.value;
+      v.value = (std::isfinite(t) && t >= v.lower && t <= v.upper) ? t : 0.5 * (v.lower + v.upper);
+    }
+    a.field("x0", v.value, Rule::any(), FieldOptions::not_identity());
+    FieldOptions scale = FieldOptions::not_identity();
+    scale.enabled = a.reading() || v.scale > 0;  // 0: upper - lower (never written)
+    a.field("scale", v.scale, Rule::positive(), scale);
+  });
+  if (a.reading() && !v.free && std::isnan(v.value))
+    throw ConfigError(a.path(key), "<missing>",
+                      "is required (the profile template has no segment " + std::to_string(index) + ")");
+}
+
+}  // namespace
+
+void describe_design_fields(FieldArchive& a, ProfileDesign& d, const StartupProfile& tmpl) {
+  a.field("start_frequency_hz", d.start_frequency_hz, Rule::non_negative());
+  const auto fill = [&](std::size_t n) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const std::size_t old_size = d.segments.size();
+    d.segments.resize(n);
+    for (std::size_t i = old_size; i < n; ++i) {
+      const bool in_template = i < tmpl.segments().size();
+      d.segments[i].end_frequency_hz.value = in_template ? tmpl.segments()[i].end_frequency_hz : nan;
+      d.segments[i].duration_s.value = in_template ? tmpl.segments()[i].duration_s : nan;
+    }
+  };
+  a.list("segments", d.segments.size(), fill,
+         [&](std::size_t i) {
+           describe_design_value(a, "end_frequency_hz", d.segments[i].end_frequency_hz, i);
+           describe_design_value(a, "duration_s", d.segments[i].duration_s, i);
+         },
+         FieldOptions::required_key("(one entry per profile segment: {end_frequency_hz, duration_s})"));
+  if (a.reading() && d.segments.empty()) throw ConfigError(a.path("segments"), "[]", "must have at least one segment");
+}
+
+void describe_fields(FieldArchive& a, ObjectiveSettings& o) {
+  a.field("kind", o.kind, kObjectiveKindNames);
+  a.field("definition", o.definition, kImbalanceDefinitionNames);
+  const bool weighted = o.kind == ObjectiveKind::Weighted;
+  if (a.reading() && weighted && !a.has("weights"))
+    throw ConfigError(a.path("weights"), "<missing>", "is required with objective.kind: weighted ({mean: w1, pct_mi: w2})");
+  a.section("weights", [&] {
+    a.field("mean", o.weight_mean, Rule::non_negative());
+    a.field("pct_mi", o.weight_pct_mi, Rule::non_negative());
+  }, FieldOptions::only_if(weighted, "is only used with objective.kind: weighted"));
+  FieldOptions robust;
+  robust.enabled = a.reading() || !o.robust_friction_mu.empty();
+  a.section("robust", [&] {
+    a.field("friction_mu", o.robust_friction_mu, Rule::in_range(0.0, 0.999), FieldOptions::required_key());
+  }, robust);
+  a.field("max_failed_fraction", o.max_failed_fraction, Rule::in_range(0.0, 1.0));
+}
+
+void describe_fields(FieldArchive& a, ConstraintSettings& c) {
+  a.field("max_startup_time_s", c.max_startup_time_s, Rule::positive());
+  a.field("max_amplitude_mm", c.max_amplitude_mm, Rule::positive());
+  a.field("max_pct_mi", c.max_pct_mi, Rule::in_range(1e-9, 100.0));
+  a.field("amplitude", c.amplitude, kAmplitudeStatisticNames);
+  a.field("penalty_weight", c.penalty_weight, Rule::non_negative());
+}
+
+// The validation section; its defaults follow the Monte Carlo section (seed + 1) and the balls.
+void describe_validation_fields(FieldArchive& a, ValidationSettings& v, const MonteCarloStudy& study) {
+  const bool runs_given = a.has("runs");
+  if (a.reading()) v.seed = study.seed + 1;
+  a.field("enabled", v.enabled);
+  a.field("design", v.design, kInitialConditionKindNames);
+  a.field("grid", v.grid, Rule::at_least(1));
+  double grid_runs = 1;
+  for (std::size_t b = 0; b < study.setup.abu.balls.size(); ++b) grid_runs *= static_cast<double>(v.grid);
+  a.field("runs", v.runs, Rule::at_least(1));
+  if (a.reading()) {
+    if (!runs_given)
+      v.runs = v.design == InitialConditionKind::Grid ? static_cast<std::size_t>(grid_runs) : 1024;
+    else if (v.design == InitialConditionKind::Grid && static_cast<double>(v.runs) != grid_runs)
+      throw ConfigError(a.path("runs"), std::to_string(v.runs),
+                        "must equal validation.grid^balls = " + format_number(grid_runs) + " with the grid design");
+  }
+  a.field("seed", v.seed, Rule::in_range(0, 9007199254740992.0));
+}
+
+void describe_fields(FieldArchive& a, StartupProfileSettings& s) {
+  describe_fields(a, s.study.setup);  // abu, profile, motor, simulation
+  a.section("montecarlo", [&] { describe_montecarlo_fields(a, s.study, s.threads); },
+            FieldOptions::derived_defaults());
+  if (a.reading()) validate(s.study, "montecarlo");
+  FieldOptions design = FieldOptions::required_key(
+      "(design: {segments: [...]} with at least one free {min, max} value)");
+  if (a.reading()) s.design.start_frequency_hz = s.study.setup.profile.start_frequency_hz();
+  a.section("design", [&] { describe_design_fields(a, s.design, s.study.setup.profile); }, design);
+  a.nested("objective", s.objective);
+  if (a.reading() && !s.objective.robust_friction_mu.empty() &&
+      s.study.uncertain.friction.sampling != FrictionSampling::Nominal)
+    throw ConfigError("objective.robust.friction_mu", list_text(s.objective.robust_friction_mu),
+                      "cannot be combined with montecarlo.friction (give the friction values in one place)");
+  a.nested("constraints", s.constraints);
+  FieldOptions validation = FieldOptions::derived_defaults();
+  validation.identity = false;  // the out-of-sample check does not decide evaluate(x)
+  a.section("validation", [&] { describe_validation_fields(a, s.validation, s.study); }, validation);
+}
+
 // ---- Reading ---------------------------------------------------------------------------------
 
 ProfileDesign read_profile_design(YamlReader design, const StartupProfile& tmpl) {
-  ProfileDesign d;
   if (!design.present())
     throw ConfigError("design", "<missing>",
                       "is required (design: {segments: [...]} with at least one free {min, max} value)");
-  d.start_frequency_hz = design.get_double_or("start_frequency_hz", tmpl.start_frequency_hz(), Rule::non_negative());
-  if (!design.has("segments"))
-    throw ConfigError(design.key_path("segments"), "<missing>",
-                      "is required (one entry per profile segment: {end_frequency_hz, duration_s})");
-  auto segs = design.children("segments");
-  if (segs.empty()) throw ConfigError(design.key_path("segments"), "[]", "must have at least one segment");
-  for (std::size_t i = 0; i < segs.size(); ++i) {
-    YamlReader& s = segs[i];
-    const bool in_template = i < tmpl.segments().size();
-    SegmentDesign sd;
-    sd.end_frequency_hz = read_design_value(
-        s, "end_frequency_hz", in_template ? std::optional<double>(tmpl.segments()[i].end_frequency_hz) : std::nullopt, i);
-    sd.duration_s = read_design_value(
-        s, "duration_s", in_template ? std::optional<double>(tmpl.segments()[i].duration_s) : std::nullopt, i);
-    s.finish();
-    d.segments.push_back(sd);
-  }
+  ProfileDesign d;
+  d.start_frequency_hz = tmpl.start_frequency_hz();
+  YamlReadArchive a(design);
+  describe_design_fields(a, d, tmpl);
   design.finish();
   return d;
 }
 
 StartupProfileSettings read_startup_profile_settings(YamlReader& root) {
   StartupProfileSettings s;
-  SimulationSetup setup = read_simulation_setup(root);
-  MonteCarloConfig mc = read_monte_carlo_config(root, std::move(setup));
-  s.study = std::move(mc.study);
-  s.threads = mc.threads;
-  s.design = read_profile_design(root.child("design"), s.study.setup.profile);
-
-  YamlReader o = root.child("objective");
-  const std::string kind = o.get_choice_or("kind", "mean", {"mean", "pct_mi", "weighted"});
-  s.objective.kind = kind == "mean" ? ObjectiveKind::mean : kind == "pct_mi" ? ObjectiveKind::pct_mi : ObjectiveKind::weighted;
-  s.objective.definition = o.get_choice_or("definition", "magnitude", {"magnitude", "report_x"}) == "magnitude"
-                               ? ImbalanceDefinition::magnitude
-                               : ImbalanceDefinition::report_x;
-  if (o.has("weights")) {
-    YamlReader w = o.child("weights");
-    if (s.objective.kind != ObjectiveKind::weighted)
-      throw ConfigError(o.key_path("weights"), yaml_value_text(w.node()), "is only used with objective.kind: weighted");
-    s.objective.weight_mean = w.get_double_or("mean", 1.0, Rule::non_negative());
-    s.objective.weight_pct_mi = w.get_double_or("pct_mi", 0.0, Rule::non_negative());
-    w.finish();
-  } else {
-    o.child("weights");
-    if (s.objective.kind == ObjectiveKind::weighted)
-      throw ConfigError(o.key_path("weights"), "<missing>", "is required with objective.kind: weighted ({mean: w1, pct_mi: w2})");
-  }
-  YamlReader robust = o.child("robust");
-  if (robust.present()) {
-    s.objective.robust_friction_mu = robust.get_double_list("friction_mu", Rule::in_range(0.0, 0.999));
-    robust.finish();
-  }
-  s.objective.max_failed_fraction = o.get_double_or("max_failed_fraction", 0.05, Rule::in_range(0.0, 1.0));
-  o.finish();
-  if (!s.objective.robust_friction_mu.empty() && s.study.uncertain.friction.sampling != FrictionSampling::Nominal)
-    throw ConfigError("objective.robust.friction_mu", list_text(s.objective.robust_friction_mu),
-                      "cannot be combined with montecarlo.friction (give the friction values in one place)");
-
-  YamlReader c = root.child("constraints");
-  if (c.has("max_startup_time_s")) s.constraints.max_startup_time_s = c.get_double("max_startup_time_s", Rule::positive());
-  if (c.has("max_amplitude_mm")) s.constraints.max_amplitude_mm = c.get_double("max_amplitude_mm", Rule::positive());
-  if (c.has("max_pct_mi")) s.constraints.max_pct_mi = c.get_double("max_pct_mi", Rule::in_range(1e-9, 100.0));
-  s.constraints.amplitude =
-      c.get_choice_or("amplitude", "max", {"max", "mean"}) == "max" ? AmplitudeStatistic::max : AmplitudeStatistic::mean;
-  s.constraints.penalty_weight = c.get_double_or("penalty_weight", 0.0, Rule::non_negative());
-  c.finish();
-
-  YamlReader v = root.child("validation");
-  s.validation.enabled = v.get_bool_or("enabled", true);
-  s.validation.design = kind_of(v.get_choice_or("design", "random", {"grid", "random", "lhs", "halton", "sobol"}),
-                                v.key_path("design"));
-  s.validation.grid = static_cast<std::size_t>(v.get_int_or("grid", 32, Rule::at_least(1)));
-  const std::size_t balls = s.study.setup.abu.balls.size();
-  double grid_runs = 1;
-  for (std::size_t b = 0; b < balls; ++b) grid_runs *= static_cast<double>(s.validation.grid);
-  if (v.has("runs")) {
-    s.validation.runs = static_cast<std::size_t>(v.get_int("runs", Rule::at_least(1)));
-    if (s.validation.design == InitialConditionKind::Grid && static_cast<double>(s.validation.runs) != grid_runs)
-      throw ConfigError(v.key_path("runs"), std::to_string(s.validation.runs),
-                        "must equal validation.grid^balls = " + format_number(grid_runs) + " with the grid design");
-  } else {
-    v.get_int_or("runs", 0);
-    s.validation.runs = s.validation.design == InitialConditionKind::Grid ? static_cast<std::size_t>(grid_runs) : 1024;
-  }
-  s.validation.seed = static_cast<std::uint64_t>(
-      v.get_int_or("seed", static_cast<long>(s.study.seed + 1), Rule::in_range(0, 9007199254740992.0)));
-  v.finish();
-
+  YamlReadArchive a(root);
+  describe_fields(a, s);
   validate(s);
   return s;
 }
 
 void validate(const StartupProfileSettings& s) {
+  validate_fields(s.objective, "objective");
+  validate_fields(s.constraints, "constraints");
   const ProfileDesign& d = s.design;
   if (d.segments.empty()) throw ConfigError("design.segments", "[]", "must have at least one segment");
   if (!(std::isfinite(d.start_frequency_hz) && d.start_frequency_hz >= 0))
@@ -252,7 +229,7 @@ void validate(const StartupProfileSettings& s) {
     throw ConfigError("design.segments", std::to_string(d.segments.size()) + " segments, all values fixed",
                       "no free variable: give at least one value as {min: ..., max: ...}");
   const ObjectiveSettings& o = s.objective;
-  if (o.kind == ObjectiveKind::weighted && !(o.weight_mean > 0 || o.weight_pct_mi > 0))
+  if (o.kind == ObjectiveKind::Weighted && !(o.weight_mean > 0 || o.weight_pct_mi > 0))
     throw ConfigError("objective.weights", "{mean: " + format_number(o.weight_mean) + ", pct_mi: " +
                                                format_number(o.weight_pct_mi) + "}",
                       "at least one weight must be > 0");
@@ -367,16 +344,16 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
   }
 
   const ObjectiveSettings& os = settings_.objective;
-  const bool x_def = os.definition == ImbalanceDefinition::report_x;
+  const bool x_def = os.definition == ImbalanceDefinition::ReportX;
   auto ir = [x_def](const MonteCarloStats& st) -> const ResidualImbalanceStats& {
     return x_def ? st.report_x : st.magnitude;
   };
   auto objective_of = [&](const MonteCarloStats& st) {
     const double mean = ir(st).mean / kUnit, pct = ir(st).pct_mi;
     switch (os.kind) {
-      case ObjectiveKind::mean: return mean;
-      case ObjectiveKind::pct_mi: return pct;
-      case ObjectiveKind::weighted: return os.weight_mean * mean + os.weight_pct_mi * pct;
+      case ObjectiveKind::Mean: return mean;
+      case ObjectiveKind::PctMi: return pct;
+      case ObjectiveKind::Weighted: return os.weight_mean * mean + os.weight_pct_mi * pct;
     }
     return mean;
   };
@@ -463,7 +440,7 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
   std::vector<double> g;
   if (c.max_startup_time_s) g.push_back(profile.duration_s() / *c.max_startup_time_s - 1.0);
   if (c.max_amplitude_mm) {
-    const double a = c.amplitude == AmplitudeStatistic::max ? all.amplitude_max_mm : all.amplitude_mean_mm;
+    const double a = c.amplitude == AmplitudeStatistic::Max ? all.amplitude_max_mm : all.amplitude_mean_mm;
     g.push_back(a / *c.max_amplitude_mm - 1.0);
   }
   if (c.max_pct_mi) g.push_back(ir(all).pct_mi / *c.max_pct_mi - 1.0);
@@ -472,37 +449,9 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
 }
 
 std::string StartupProfileProblem::identity_text() const {
-  const StartupProfileSettings& s = settings_;
-  std::ostringstream os;
-  os << "# abuopt startup_profile problem, evaluation v1\n";
-  os << to_yaml(s.study.setup);
-  const SimulationOptions& so = s.study.setup.options;
-  os << "simulation_extra: {switch_band: " << format_number(so.switch_band) << ", max_steps: " << so.max_steps
-     << ", max_events: " << so.max_events << ", chatter_events: " << so.chatter_events
-     << ", chatter_window_s: " << format_number(so.chatter_window_s) << "}\n";
-  os << "design:\n  start_frequency_hz: " << format_number(s.design.start_frequency_hz) << "\n";
-  for (std::size_t i = 0; i < s.design.segments.size(); ++i) {
-    const std::string index = std::to_string(i + 1);
-    append_value(os, std::string("f").append(index), s.design.segments[i].end_frequency_hz);
-    append_value(os, std::string("dt").append(index), s.design.segments[i].duration_s);
-  }
-  const InitialConditionDesign d = study_design(s.study);
-  os << "montecarlo:\n  design: " << to_string(d.kind) << "\n  grid: " << d.grid_points_per_axis
-     << "\n  runs: " << s.study.runs << "\n  seed: " << s.study.seed << "\n  design_seed: " << d.seed
-     << "\n  shift: " << d.random_shift << "\n";
-  os << uncertain_text(s.study.uncertain);
-  const ObjectiveSettings& o = s.objective;
-  os << "objective: {kind: " << to_string(o.kind) << ", definition: " << to_string(o.definition)
-     << ", weights: [" << format_number(o.weight_mean) << ", " << format_number(o.weight_pct_mi)
-     << "], robust_friction_mu: " << list_text(o.robust_friction_mu)
-     << ", max_failed_fraction: " << format_number(o.max_failed_fraction) << "}\n";
-  const ConstraintSettings& c = s.constraints;
-  auto opt_text = [](const std::optional<double>& v) { return v ? format_number(*v) : std::string("none"); };
-  os << "constraints: {max_startup_time_s: " << opt_text(c.max_startup_time_s)
-     << ", max_amplitude_mm: " << opt_text(c.max_amplitude_mm) << ", amplitude: " << to_string(c.amplitude)
-     << ", max_pct_mi: " << opt_text(c.max_pct_mi) << ", penalty_weight: " << format_number(c.penalty_weight)
-     << "}\n";
-  return os.str();
+  // Every identity field of the field lists (bounds, x0, scales, threads and the validation
+  // section are marked out of it): a new key is in the identity as soon as it is described.
+  return "# abuopt startup_profile problem, evaluation v2\n" + identity_fields(settings_);
 }
 
 std::string StartupProfileProblem::identity() const {

@@ -19,21 +19,6 @@ namespace {
 
 const char* const kSetupSections[] = {"abu", "profile", "motor", "simulation", "montecarlo"};
 
-// Checks that a raw mapping only has the allowed keys (for entries read by hand).
-void check_keys(const YAML::Node& n, const std::string& path, const std::set<std::string>& allowed) {
-  if (!n.IsMap()) throw ConfigError(path, yaml_value_text(n), "must be a mapping of keys");
-  for (auto it = n.begin(); it != n.end(); ++it) {
-    const std::string k = it->first.Scalar();
-    if (!allowed.count(k))
-      throw ConfigError(path + "." + k, yaml_value_text(it->second), "unknown key (misspelt, or not valid here)");
-  }
-}
-
-std::string scalar_string(const YAML::Node& n, const std::string& path) {
-  if (!n || !n.IsScalar()) throw ConfigError(path, n ? yaml_value_text(n) : "<missing>", "must be a string");
-  return n.Scalar();
-}
-
 ConclusionCheck conclusion_check_from_string(const std::string& s, const std::string& path) {
   for (ConclusionCheck c : {ConclusionCheck::BeatsAll, ConclusionCheck::PctMiDecreasesWithValue,
                             ConclusionCheck::WorsensWithValue})
@@ -93,19 +78,12 @@ ReproductionTable read_table(YamlReader& root, const std::string& name) {
     c.finish();
     t.conclusions.push_back(std::move(k));
   }
-  // Plot entries hold a list of strings, which the reader has no getter for: each entry is
-  // checked and read by hand (children() marks the key as read).
   for (YamlReader& p : tr.children("plots")) {
-    const YAML::Node& n = p.node();
-    check_keys(n, p.path(), {"kind", "name", "cases"});
     PlotRequest req;
-    req.kind = plot_kind_from_string(scalar_string(n["kind"], p.key_path("kind")), p.key_path("kind"));
-    req.name = n["name"] ? scalar_string(n["name"], p.key_path("name")) : t.id + "_" + to_string(req.kind);
-    if (const YAML::Node cs = n["cases"]) {
-      if (!cs.IsSequence()) throw ConfigError(p.key_path("cases"), yaml_value_text(cs), "must be a list of case ids");
-      for (std::size_t i = 0; i < cs.size(); ++i)
-        req.case_ids.push_back(scalar_string(cs[i], p.key_path("cases") + "[" + std::to_string(i) + "]"));
-    }
+    req.kind = plot_kind_from_string(p.get_string("kind"), p.key_path("kind"));
+    req.name = p.get_string_or("name", t.id + "_" + to_string(req.kind));
+    req.case_ids = p.get_string_list_or("cases");
+    p.finish();
     t.plots.push_back(std::move(req));
   }
   tr.finish();
@@ -196,22 +174,6 @@ const ReproductionCase* ReproductionTable::find_case(const std::string& case_id)
 }
 
 // --- reading -----------------------------------------------------------------------------------
-
-YAML::Node merge_yaml(const YAML::Node& base, const YAML::Node& overlay) {
-  if (!overlay || overlay.IsNull()) return YAML::Clone(base);
-  if (!base || !base.IsMap() || !overlay.IsMap()) return YAML::Clone(overlay);
-  YAML::Node out = YAML::Clone(base);
-  for (auto it = overlay.begin(); it != overlay.end(); ++it) {
-    const std::string key = it->first.Scalar();
-    const YAML::Node& cout_ = out;  // const lookup: does not insert
-    const YAML::Node existing = cout_[key];
-    if (existing && existing.IsMap() && it->second.IsMap())
-      out[key] = merge_yaml(existing, it->second);
-    else
-      out[key] = YAML::Clone(it->second);
-  }
-  return out;
-}
 
 ReproductionTable read_reproduction_table_string(const std::string& yaml_text, const std::string& name) {
   try {

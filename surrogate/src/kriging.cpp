@@ -185,7 +185,7 @@ Kriging::Kriging(KrigingOptions options) : options_(std::move(options)) {}
 void Kriging::fit(const Eigen::MatrixXd& X, const Eigen::VectorXd& y) {
   detail::check_training_data("Kriging::fit", X, y);
   if (X.rows() < 2) {
-    throw std::invalid_argument("Kriging::fit: kriging needs at least 2 points, got " +
+    throw InsufficientData("Kriging::fit: kriging needs at least 2 points, got " +
                                 std::to_string(X.rows()));
   }
   const int n = static_cast<int>(X.cols());
@@ -278,7 +278,7 @@ void Kriging::fit(const Eigen::MatrixXd& X, const Eigen::VectorXd& y) {
     f = factorise(X, y, inv_sq, nugget);
   }
   if (!f.ok) {
-    throw std::invalid_argument(
+    throw InsufficientData(
         "Kriging::fit: the correlation matrix is not positive definite even with nugget " +
         std::to_string(nugget) + " (duplicate points or far too long length scales?)");
   }

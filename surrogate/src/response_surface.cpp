@@ -134,7 +134,7 @@ void ResponseSurface::fit(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
   const std::string model = describe(basis_) + " in " + std::to_string(n) +
                             (n == 1 ? " variable" : " variables");
   if (m < p) {
-    throw std::invalid_argument(model + " needs at least " + std::to_string(p) +
+    throw InsufficientData(model + " needs at least " + std::to_string(p) +
                                 " points, got " + std::to_string(m) +
                                 (m == m_all ? "" : " (with positive weight)"));
   }
@@ -150,7 +150,7 @@ void ResponseSurface::fit(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Aw);
   qr.setThreshold(kRankThreshold);
   if (qr.rank() < p) {
-    throw std::invalid_argument(model + " needs at least " + std::to_string(p) +
+    throw InsufficientData(model + " needs at least " + std::to_string(p) +
                                 " points in general position, got " + std::to_string(m) +
                                 " whose design matrix has rank " + std::to_string(qr.rank()) +
                                 " (rank-deficient design: e.g. two levels per variable cannot "

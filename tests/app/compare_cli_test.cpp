@@ -1,6 +1,8 @@
 // `abuopt compare` end to end on the built binary: the shipped benchmark comparison runs (exit 0,
 // the table on stdout, the CSVs under --out), and a bad config is one message with exit status 2.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
@@ -22,7 +24,9 @@ struct Result {
 
 // Runs the binary with stdout captured and stderr in a file beside it.
 Result run(const std::string& args) {
-  const std::string err_file = std::string(ABUOPT_BINARY_DIR) + "/compare_cli_stderr.txt";
+  // One file per test process: ctest runs the tests of this file in parallel.
+  const std::string err_file =
+      std::string(ABUOPT_BINARY_DIR) + "/compare_cli_stderr." + std::to_string(getpid()) + ".txt";
   const std::string cmd = std::string(ABUOPT_EXE) + " " + args + " 2>" + err_file;
   std::array<char, 4096> buf{};
   std::string out;

@@ -59,7 +59,7 @@ TEST_P(BenchmarkConvergence, ReachesBestKnown) {
   o.max_evaluations = c.budget;
   o.constraint_tolerance = c.constraint_tol;
   o.fd_relative_step = c.fd_step;
-  o.finite_difference = c.fd == "central" ? opt::FiniteDifference::central : opt::FiniteDifference::forward;
+  o.finite_difference = c.fd == "central" ? opt::FiniteDifference::Central : opt::FiniteDifference::Forward;
   const opt::OptimizationResult r = opt::minimize(*problem, o);
 
   const double scale = std::max(1.0, std::fabs(best.objective));

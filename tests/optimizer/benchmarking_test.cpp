@@ -175,10 +175,10 @@ TEST(Comparison, ReadSolverSpec) {
   auto entries = root.children("solvers");
   const opt::SolverSpec a = opt::read_solver_spec(entries[0]);
   EXPECT_EQ(a.label, "SAO-q");
-  EXPECT_EQ(a.options.sao.surrogate, "quadratic");
+  EXPECT_EQ(a.options.sao.surrogate, opt::SurrogateKind::Quadratic);
   const opt::SolverSpec b = opt::read_solver_spec(entries[1]);
   EXPECT_EQ(b.label, "slsqp");
-  EXPECT_EQ(b.options.finite_difference, opt::FiniteDifference::central);
+  EXPECT_EQ(b.options.finite_difference, opt::FiniteDifference::Central);
   try {
     opt::read_solver_spec(entries[2]);
     FAIL() << "no ConfigError";

@@ -68,7 +68,7 @@ TEST(Minimize, StopsAtTheBudgetAndReturnsTheBestSoFar) {
   for (const char* alg : {"COBYLA", "SLSQP", "IPOPT", "DIRECT_L"}) {
     auto p = quadratic();
     const auto r = minimize(p, with(alg, 7));
-    EXPECT_EQ(r.reason, TerminationReason::max_evaluations) << alg << ": " << r.message;
+    EXPECT_EQ(r.reason, TerminationReason::MaxEvaluations) << alg << ": " << r.message;
     EXPECT_EQ(r.evaluations, 7) << alg;
     ASSERT_EQ(r.history.size(), 7u) << alg;
     EXPECT_EQ(r.objective, best_in_history(r)) << alg;
@@ -85,7 +85,7 @@ TEST(Minimize, CallbackCanStopTheRun) {
     EXPECT_EQ(pr.last.index, pr.evaluations - 1);
     return pr.evaluations < 5;
   });
-  EXPECT_EQ(r.reason, TerminationReason::stopped_by_callback);
+  EXPECT_EQ(r.reason, TerminationReason::StoppedByCallback);
   EXPECT_EQ(r.evaluations, 5);
   EXPECT_EQ(seen, 5);
   EXPECT_EQ(r.objective, best_in_history(r));
@@ -102,7 +102,7 @@ TEST(Minimize, AnExceptionInsideAnEvaluationEndsTheRunWithTheBestSoFar) {
     });
     OptimizationResult r;
     ASSERT_NO_THROW(r = minimize(p, with(alg)));
-    EXPECT_EQ(r.reason, TerminationReason::evaluation_error) << alg;
+    EXPECT_EQ(r.reason, TerminationReason::EvaluationError) << alg;
     EXPECT_NE(r.message.find("simulator exploded"), std::string::npos) << r.message;
     EXPECT_EQ(r.evaluations, 10) << alg;
     EXPECT_TRUE(r.has_feasible_point());
@@ -118,7 +118,7 @@ TEST(Minimize, SigintInterruptsAndRestoresThePreviousHandler) {
     if (pr.evaluations == 6) std::raise(SIGINT);  // what Ctrl-C does
     return true;
   });
-  EXPECT_EQ(r.reason, TerminationReason::interrupted);
+  EXPECT_EQ(r.reason, TerminationReason::Interrupted);
   EXPECT_EQ(r.evaluations, 6);
   EXPECT_EQ(r.objective, best_in_history(r));
   struct sigaction after {};
@@ -138,7 +138,7 @@ TEST(Minimize, SigintInterruptsSaoAndRestoresThePreviousHandler) {
     if (pr.evaluations == 5) std::raise(SIGINT);
     return true;
   });
-  EXPECT_EQ(r.reason, TerminationReason::interrupted);
+  EXPECT_EQ(r.reason, TerminationReason::Interrupted);
   EXPECT_EQ(r.evaluations, 5);
   EXPECT_EQ(r.algorithm, "SAO(auto)");
   struct sigaction after {};
@@ -152,7 +152,7 @@ TEST(Minimize, RequestStopInterruptsIpopt) {
     if (pr.evaluations == 4) request_stop();
     return true;
   });
-  EXPECT_EQ(r.reason, TerminationReason::interrupted);
+  EXPECT_EQ(r.reason, TerminationReason::Interrupted);
   EXPECT_EQ(r.evaluations, 4);
 }
 
@@ -176,7 +176,7 @@ TEST(Minimize, NoAlgorithmEvaluatesOutsideTheBounds) {
       EXPECT_LE(h.x[1], 2.0);
     }
     // minimum at the corner (1, -0.5): f = 4 + 6.25 - 0.5 = 9.75 (global methods: 300 evaluations)
-    const double tol = find_algorithm(name).family == AlgorithmFamily::global ? 0.5 : 0.05;
+    const double tol = find_algorithm(name).family == AlgorithmFamily::Global ? 0.5 : 0.05;
     EXPECT_NEAR(r.objective, 9.75, tol) << name << ": " << r.brief_report();
   }
 }
@@ -197,7 +197,7 @@ TEST(Minimize, FailedEvaluationsAreInfiniteAndDoNotEndTheRun) {
     OptimizerOptions o = with(alg);
     o.initial_step = 0.5;  // first steps reach into the failing region
     const auto r = minimize(p, o, {0.5, 0.5});
-    if (find_algorithm(alg).family == AlgorithmFamily::local_derivative_free) {
+    if (find_algorithm(alg).family == AlgorithmFamily::LocalDerivativeFree) {
       EXPECT_GT(r.failed_evaluations, 0) << alg;  // (gradient methods may never step there)
     }
     EXPECT_TRUE(r.success()) << alg << ": " << r.full_report();
@@ -213,7 +213,7 @@ TEST(Minimize, FailedEvaluationsAreInfiniteAndDoNotEndTheRun) {
   auto p = problem();
   const auto r = minimize(p, with("COBYLA"), {0.9, 0.9});
   EXPECT_FALSE(r.success());
-  EXPECT_EQ(r.reason, TerminationReason::infeasible);
+  EXPECT_EQ(r.reason, TerminationReason::Infeasible);
   EXPECT_EQ(r.failed_evaluations, r.evaluations);
 }
 
@@ -232,7 +232,7 @@ TEST(Minimize, ConvergenceAtAnInfeasiblePointIsNotASuccess) {
     const auto r = minimize(p, with(alg, 500));
     EXPECT_FALSE(r.success()) << alg << ": " << r.full_report();
     EXPECT_FALSE(r.feasible) << alg;
-    EXPECT_NE(r.reason, TerminationReason::converged) << alg;
+    EXPECT_NE(r.reason, TerminationReason::Converged) << alg;
     EXPECT_NEAR(r.max_violation, 0.5, 1e-3) << alg << ": the least infeasible point is (1, 1)";
   }
 }
@@ -269,7 +269,7 @@ TEST(Minimize, TargetStopsAtTheFirstFeasiblePointBelowIt) {
   OptimizerOptions o = with("NELDERMEAD");
   o.target = 0.01;
   const auto r = minimize(p, o, {0.9, 0.9});
-  EXPECT_EQ(r.reason, TerminationReason::target_reached);
+  EXPECT_EQ(r.reason, TerminationReason::TargetReached);
   EXPECT_LE(r.objective, 0.01);
   EXPECT_GT(r.history[r.history.size() - 2].objective, 0.0);  // stopped right after reaching it
   EXPECT_TRUE(r.success());
@@ -285,7 +285,7 @@ TEST(Minimize, TimeLimitStopsTheRun) {
   OptimizerOptions o = with("DIRECT_L");
   o.max_time_s = 0.1;
   const auto r = minimize(p, o);
-  EXPECT_EQ(r.reason, TerminationReason::max_time);
+  EXPECT_EQ(r.reason, TerminationReason::MaxTime);
   EXPECT_LE(r.evaluations, 12);
   EXPECT_LT(r.wall_time_s, 0.5);
 }
@@ -303,15 +303,15 @@ TEST(Minimize, FiniteDifferenceStepIsRelativeToMaxOfValueAndScale) {
     o.finite_difference = kind;
     return minimize(p, o, {x0});
   };
-  auto r = run(50, FiniteDifference::forward, 500);
+  auto r = run(50, FiniteDifference::Forward, 500);
   ASSERT_EQ(r.history.size(), 3u);
   EXPECT_FALSE(r.history[0].for_gradient);
   EXPECT_TRUE(r.history[1].for_gradient);
   EXPECT_NEAR(r.history[1].x[0] - 50, 0.1, 1e-9);  // 1e-3 * max(50, 100)
-  r = run(300, FiniteDifference::central, 500);
+  r = run(300, FiniteDifference::Central, 500);
   EXPECT_NEAR(r.history[1].x[0] - 300, 0.3, 1e-9);  // 1e-3 * max(300, 100)
   EXPECT_NEAR(r.history[2].x[0] - 300, -0.3, 1e-9);
-  r = run(500, FiniteDifference::central, 500);  // at the upper bound: one-sided, backward
+  r = run(500, FiniteDifference::Central, 500);  // at the upper bound: one-sided, backward
   EXPECT_NEAR(r.history[1].x[0] - 500, -0.5, 1e-9);
   EXPECT_EQ(r.gradient_evaluations, 1 + (r.history[2].for_gradient ? 1 : 0));
 }
@@ -336,7 +336,7 @@ TEST(Minimize, IpoptBudgetIsEnforcedByTheWrapper) {
     return e;
   });
   const auto r = minimize(p, with("ipopt", 20), {-1.2, 1});
-  EXPECT_EQ(r.reason, TerminationReason::max_evaluations);
+  EXPECT_EQ(r.reason, TerminationReason::MaxEvaluations);
   EXPECT_EQ(r.evaluations, 20);
   EXPECT_LT(r.objective, 24.2);  // better than the start
 }
@@ -379,7 +379,7 @@ TEST(Minimize, ShapeMismatchIsAnEvaluationError) {
       },
       {"g"});
   const auto r = minimize(p, with("cobyla"));
-  EXPECT_EQ(r.reason, TerminationReason::evaluation_error);
+  EXPECT_EQ(r.reason, TerminationReason::EvaluationError);
   EXPECT_NE(r.message.find("declares 1 inequality constraints, the evaluation returned 0"), std::string::npos);
 }
 

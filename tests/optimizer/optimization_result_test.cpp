@@ -10,21 +10,21 @@ namespace {
 using namespace abuopt::opt;
 
 TEST(TerminationReason, NamesRoundTrip) {
-  for (int i = 0; i <= static_cast<int>(TerminationReason::failure); ++i) {
+  for (int i = 0; i <= static_cast<int>(TerminationReason::Failure); ++i) {
     const auto r = static_cast<TerminationReason>(i);
     EXPECT_EQ(termination_reason_from_string(to_string(r)), r);
   }
-  EXPECT_EQ(to_string(TerminationReason::max_evaluations), "max_evaluations");
+  EXPECT_EQ(to_string(TerminationReason::MaxEvaluations), "max_evaluations");
   EXPECT_THROW(termination_reason_from_string("done"), abuopt::ConfigError);
-  EXPECT_TRUE(is_convergence(TerminationReason::converged_xtol));
-  EXPECT_FALSE(is_convergence(TerminationReason::max_evaluations));
+  EXPECT_TRUE(is_convergence(TerminationReason::ConvergedXtol));
+  EXPECT_FALSE(is_convergence(TerminationReason::MaxEvaluations));
 }
 
 OptimizationResult sample() {
   OptimizationResult r;
   r.problem_name = "demo";
   r.algorithm = "SLSQP";
-  r.reason = TerminationReason::converged_ftol;
+  r.reason = TerminationReason::ConvergedFtol;
   r.message = "NLopt: ftol_rel or ftol_abs reached";
   r.x = {1.5, 2};
   r.x0 = {1, 1};
@@ -49,7 +49,7 @@ TEST(OptimizationResult, SuccessRequiresConvergenceAndFeasibility) {
   r.feasible = false;
   EXPECT_FALSE(r.success());
   r = sample();
-  r.reason = TerminationReason::max_evaluations;
+  r.reason = TerminationReason::MaxEvaluations;
   EXPECT_FALSE(r.success());
   EXPECT_TRUE(r.has_feasible_point());
 }

@@ -31,7 +31,7 @@ TEST(OptimizerOptions, DefaultsAreValid) {
   EXPECT_NO_THROW(o.validate());
   EXPECT_EQ(o.algorithm, "cobyla");
   EXPECT_EQ(o.max_evaluations, 1000);
-  EXPECT_EQ(o.finite_difference, FiniteDifference::forward);
+  EXPECT_EQ(o.finite_difference, FiniteDifference::Forward);
   EXPECT_FALSE(o.target.has_value());
 }
 
@@ -51,7 +51,7 @@ TEST(OptimizerOptions, ReadsEveryKey) {
   EXPECT_EQ(o.ftol_abs, 1e-9);
   EXPECT_EQ(o.target, 0.5);
   EXPECT_EQ(o.constraint_tolerance, 1e-4);
-  EXPECT_EQ(o.finite_difference, FiniteDifference::central);
+  EXPECT_EQ(o.finite_difference, FiniteDifference::Central);
   EXPECT_EQ(o.fd_relative_step, 1e-3);
   EXPECT_EQ(o.seed, 42u);
   EXPECT_EQ(o.population, 30);

@@ -56,9 +56,9 @@ double reciprocal_linear(const Eigen::VectorXd& x) { return 3 + 2 / x[0] - 5 / x
 TEST(InterveningVariables, ReciprocalModelRecoversReciprocalLinearFunctionExactly) {
   const InterveningData data = make_data(Eigen::Vector3d(2, 3, 1.5), Eigen::Vector3d(0.9, 1.2, 0.5), 8, 1);
   const Eigen::VectorXd y = values(data, reciprocal_linear);
-  const opt::InterveningChoice c = opt::fit_intervening("reciprocal", Basis::kLinear, data, y);
+  const opt::InterveningChoice c = opt::fit_intervening(opt::InterveningKind::Reciprocal, Basis::kLinear, data, y);
   ASSERT_TRUE(c.model);
-  EXPECT_EQ(c.form, "reciprocal");
+  EXPECT_EQ(c.form, opt::InterveningKind::Reciprocal);
   EXPECT_EQ(c.exponents, Eigen::Vector3d(-1, -1, -1));
   EXPECT_LT(c.loo_error, 1e-20);
   // exact away from the fitted points too, across the whole region
@@ -69,7 +69,7 @@ TEST(InterveningVariables, ReciprocalModelRecoversReciprocalLinearFunctionExactl
     EXPECT_TRUE(c.model->gradient(s).isApprox(df_dx.cwiseProduct(data.step), 1e-10)) << c.model->gradient(s);
   }
   // the linear model of the same data is not exact
-  const opt::InterveningChoice lin = opt::fit_intervening("linear", Basis::kLinear, data, y);
+  const opt::InterveningChoice lin = opt::fit_intervening(opt::InterveningKind::Linear, Basis::kLinear, data, y);
   EXPECT_GT(std::fabs(lin.model->value(Eigen::Vector3d(-1, -1, -1)) - reciprocal_linear(x_of(data, Eigen::Vector3d(-1, -1, -1)))), 1e-2);
 }
 
@@ -108,11 +108,11 @@ TEST(InterveningVariables, GradientFollowsTheChainRule) {
 TEST(InterveningVariables, AutoPicksReciprocalForReciprocalAndLinearForLinear) {
   const InterveningData data = make_data(Eigen::Vector3d(2, 3, 1.5), Eigen::Vector3d(0.9, 1.2, 0.5), 12, 3);
   for (Basis basis : {Basis::kLinear, Basis::kPureQuadratic}) {
-    const opt::InterveningChoice r = opt::fit_intervening("auto", basis, data, values(data, reciprocal_linear));
-    EXPECT_EQ(r.form, "reciprocal") << surrogate::to_string(basis);
+    const opt::InterveningChoice r = opt::fit_intervening(opt::InterveningKind::Auto, basis, data, values(data, reciprocal_linear));
+    EXPECT_EQ(r.form, opt::InterveningKind::Reciprocal) << surrogate::to_string(basis);
     const opt::InterveningChoice l = opt::fit_intervening(
-        "auto", basis, data, values(data, [](const Eigen::VectorXd& x) { return 1 + 2 * x[0] - x[1] + 0.1 * x[2]; }));
-    EXPECT_EQ(l.form, "linear") << surrogate::to_string(basis);
+        opt::InterveningKind::Auto, basis, data, values(data, [](const Eigen::VectorXd& x) { return 1 + 2 * x[0] - x[1] + 0.1 * x[2]; }));
+    EXPECT_EQ(l.form, opt::InterveningKind::Linear) << surrogate::to_string(basis);
   }
   // a cantilever-like constraint sum a_i / x_i^3: exponential finds p = -3 and auto takes it
   const InterveningData five = make_data(Eigen::VectorXd::Constant(5, 5.0), Eigen::VectorXd::Constant(5, 2.0), 14, 4);
@@ -122,19 +122,19 @@ TEST(InterveningVariables, AutoPicksReciprocalForReciprocalAndLinearForLinear) {
     for (int i = 0; i < 5; ++i) v += a[i] / (x[i] * x[i] * x[i]);
     return v;
   };
-  const opt::InterveningChoice e = opt::fit_intervening("auto", Basis::kLinear, five, values(five, deflection));
-  EXPECT_EQ(e.form, "exponential");
+  const opt::InterveningChoice e = opt::fit_intervening(opt::InterveningKind::Auto, Basis::kLinear, five, values(five, deflection));
+  EXPECT_EQ(e.form, opt::InterveningKind::Exponential);
   EXPECT_TRUE(e.exponents.isApprox(Eigen::VectorXd::Constant(5, -3.0))) << e.exponents.transpose();
   EXPECT_LT(e.loo_error, 1e-20);
   // too few points to compare (as many as terms): the previous choice is kept, else linear
   const InterveningData few = make_data(Eigen::Vector3d(2, 3, 1.5), Eigen::Vector3d(0.9, 1.2, 0.5), 4, 5);
-  EXPECT_EQ(opt::fit_intervening("auto", Basis::kLinear, few, values(few, reciprocal_linear)).form, "linear");
+  EXPECT_EQ(opt::fit_intervening(opt::InterveningKind::Auto, Basis::kLinear, few, values(few, reciprocal_linear)).form, opt::InterveningKind::Linear);
   opt::InterveningChoice previous;
-  previous.form = "reciprocal";
+  previous.form = opt::InterveningKind::Reciprocal;
   previous.exponents = Eigen::Vector3d(-1, -1, -1);
   const opt::InterveningChoice kept =
-      opt::fit_intervening("auto", Basis::kLinear, few, values(few, reciprocal_linear), &previous);
-  EXPECT_EQ(kept.form, "reciprocal");
+      opt::fit_intervening(opt::InterveningKind::Auto, Basis::kLinear, few, values(few, reciprocal_linear), &previous);
+  EXPECT_EQ(kept.form, opt::InterveningKind::Reciprocal);
   EXPECT_NEAR(kept.model->value(Eigen::Vector3d(-1, 1, -1)), reciprocal_linear(x_of(few, Eigen::Vector3d(-1, 1, -1))),
               1e-12);
 }
@@ -149,18 +149,19 @@ TEST(InterveningVariables, ReciprocalRefusedWhenBoundsIncludeZero) {
   InterveningData data = make_data(Eigen::Vector2d(1, 3), Eigen::Vector2d(1, 1), 10, 6, {false, true});
   data.S.row(0) << -1, -1;
   const Eigen::VectorXd y = values(data, [](const Eigen::VectorXd& x) { return 2 * x[0] + 1 / x[1]; });
-  for (const std::string form : {"reciprocal", "exponential", "auto"}) {
+  for (const opt::InterveningKind form :
+       {opt::InterveningKind::Reciprocal, opt::InterveningKind::Exponential, opt::InterveningKind::Auto}) {
     const opt::InterveningChoice c = opt::fit_intervening(form, Basis::kLinear, data, y);
-    EXPECT_EQ(c.exponents[0], 1.0) << form;
-    EXPECT_TRUE(std::isfinite(c.model->value(Eigen::Vector2d(-1, -1)))) << form;
-    EXPECT_TRUE(c.model->gradient(Eigen::Vector2d(-1, -1)).allFinite()) << form;
+    EXPECT_EQ(c.exponents[0], 1.0) << opt::to_string(form);
+    EXPECT_TRUE(std::isfinite(c.model->value(Eigen::Vector2d(-1, -1)))) << opt::to_string(form);
+    EXPECT_TRUE(c.model->gradient(Eigen::Vector2d(-1, -1)).allFinite()) << opt::to_string(form);
   }
-  EXPECT_EQ(opt::fit_intervening("reciprocal", Basis::kLinear, data, y).exponents[1], -1.0);
-  EXPECT_NEAR(opt::fit_intervening("auto", Basis::kLinear, data, y).model->value(Eigen::Vector2d(0.5, -0.5)),
+  EXPECT_EQ(opt::fit_intervening(opt::InterveningKind::Reciprocal, Basis::kLinear, data, y).exponents[1], -1.0);
+  EXPECT_NEAR(opt::fit_intervening(opt::InterveningKind::Auto, Basis::kLinear, data, y).model->value(Eigen::Vector2d(0.5, -0.5)),
               2 * 1.5 + 1 / 2.5, 1e-12);
   // no variable may be transformed: every form is the linear one
   const InterveningData none = make_data(Eigen::Vector2d(1, 3), Eigen::Vector2d(1, 1), 10, 7, {false, false});
-  EXPECT_EQ(opt::fit_intervening("reciprocal", Basis::kLinear, none, y).form, "linear");
+  EXPECT_EQ(opt::fit_intervening(opt::InterveningKind::Reciprocal, Basis::kLinear, none, y).form, opt::InterveningKind::Linear);
   // the map refuses by itself too
   const opt::InterveningMap map(Eigen::Vector2d(1, 3), Eigen::Vector2d(1, 1), Eigen::Vector2d(-1, -1), {false, true});
   EXPECT_EQ(map.exponents(), Eigen::Vector2d(1, -1));
@@ -171,10 +172,9 @@ TEST(InterveningVariables, ReciprocalRefusedWhenBoundsIncludeZero) {
 
 TEST(InterveningVariables, OptionsAreValidatedAndRead) {
   opt::SaoOptions s;
-  EXPECT_EQ(s.intervening, "auto");
-  s.intervening = "cubic";
+  EXPECT_EQ(s.intervening, opt::InterveningKind::Auto);
   try {
-    s.validate();
+    opt::intervening_kind_from_string("cubic");
     ADD_FAILURE() << "no ConfigError";
   } catch (const ConfigError& e) {
     EXPECT_STREQ(e.what(), "sao.intervening = cubic: must be one of: auto, linear, reciprocal, exponential");
@@ -183,9 +183,9 @@ TEST(InterveningVariables, OptionsAreValidatedAndRead) {
       "sao:\n  intervening: reciprocal\n  intervening_objective: linear\n");
   YamlReader section = root.child("sao");
   const opt::SaoOptions r = opt::read_sao_options(section);
-  EXPECT_EQ(r.intervening, "reciprocal");
-  EXPECT_EQ(r.intervening_objective, "linear");
-  EXPECT_EQ(r.intervening_constraints, "");  // as `intervening`
+  EXPECT_EQ(r.intervening, opt::InterveningKind::Reciprocal);
+  EXPECT_EQ(r.intervening_objective, opt::InterveningKind::Linear);
+  EXPECT_FALSE(r.intervening_constraints.has_value());  // as `intervening`
 }
 
 // Every form reaches the cantilever's optimum (its objective is linear in x, its constraint a sum
@@ -197,7 +197,7 @@ TEST(InterveningVariables, EveryFormSolvesTheCantilever) {
     opt::OptimizerOptions o;
     o.max_evaluations = 300;
     opt::SaoOptions sao;
-    sao.intervening = form;
+    sao.intervening = opt::intervening_kind_from_string(form);
     const opt::OptimizationResult r = opt::minimize_sao(*problem, o, sao);
     long to_one_percent = -1;
     for (const auto& h : r.history)

@@ -139,7 +139,7 @@ TEST(Sao, BudgetStopReturnsBestFeasiblePoint) {
   opt::OptimizerOptions o;
   o.max_evaluations = 30;
   const opt::OptimizationResult r = opt::minimize_sao(*problem, o, opt::SaoOptions{});
-  EXPECT_EQ(r.reason, opt::TerminationReason::max_evaluations);
+  EXPECT_EQ(r.reason, opt::TerminationReason::MaxEvaluations);
   EXPECT_EQ(r.evaluations, 30);
   EXPECT_FALSE(r.success());
   ASSERT_TRUE(r.has_feasible_point());
@@ -235,27 +235,58 @@ TEST(Sao, ReusesArchivedPoints) {
   std::remove(path.c_str());
 }
 
-// minimize_any dispatches "sao" (any case) to minimize_sao and everything else to minimize.
-TEST(Sao, MinimizeAnyDispatchesByName) {
+// minimize() knows SAO (any case), with its settings in OptimizerOptions::sao; minimize_sao() is
+// the same run.
+TEST(Sao, MinimizeRunsSaoByName) {
   auto problem = opt::benchmarks::make_benchmark("two_bar_truss");
   opt::OptimizerOptions o;
   o.algorithm = "Sao";
   o.max_evaluations = 200;
-  EXPECT_EQ(opt::minimize_any(*problem, o).algorithm, "SAO(auto)");
-  o.algorithm = "cobyla";
-  EXPECT_EQ(opt::minimize_any(*problem, o).algorithm, "COBYLA");
-  // minimize() itself knows SAO, with its settings in OptimizerOptions::sao
+  EXPECT_EQ(opt::minimize(*problem, o).algorithm, "SAO(auto)");
   o.algorithm = "sao";
-  o.sao.surrogate = "linear";
+  o.sao.surrogate = opt::SurrogateKind::Linear;
   const opt::OptimizationResult via_minimize = opt::minimize(*problem, o);
   EXPECT_EQ(via_minimize.algorithm, "SAO(linear)");
   opt::SaoOptions linear;
-  linear.surrogate = "linear";
+  linear.surrogate = opt::SurrogateKind::Linear;
   const opt::OptimizationResult via_sao = opt::minimize_sao(*problem, opt::OptimizerOptions{}, linear);
   EXPECT_EQ(via_minimize.evaluations, via_sao.evaluations);
   EXPECT_EQ(via_minimize.x, via_sao.x);
-  EXPECT_TRUE(opt::is_sao_algorithm("SAO"));
-  EXPECT_FALSE(opt::is_sao_algorithm("SLSQP"));
+}
+
+// One record per iteration, consistent with the run: radii follow the ratio test, accepted steps
+// have rho = actual / predicted > 0, the evaluation counts grow and end at the run's count.
+TEST(Sao, IterationRecordsDescribeEveryIteration) {
+  auto problem = opt::benchmarks::make_benchmark("hs071");
+  opt::OptimizerOptions o;
+  o.max_evaluations = 200;
+  const opt::OptimizationResult r = opt::minimize_sao(*problem, o, {});
+  ASSERT_EQ(static_cast<long>(r.iteration_records.size()), r.iterations);
+  ASSERT_GT(r.iterations, 2);
+  long accepted = 0, previous_evaluations = 0;
+  for (std::size_t k = 0; k < r.iteration_records.size(); ++k) {
+    const opt::IterationRecord& it = r.iteration_records[k];
+    EXPECT_EQ(it.iteration, static_cast<long>(k) + 1);
+    if (k > 0) {
+      EXPECT_EQ(it.radius, r.iteration_records[k - 1].next_radius);
+    }
+    EXPECT_GE(it.evaluations, previous_evaluations);
+    previous_evaluations = it.evaluations;
+    if (it.step == opt::IterationStep::Accepted) {
+      ++accepted;
+      EXPECT_GT(it.actual_reduction, 0);
+      EXPECT_DOUBLE_EQ(it.rho, it.actual_reduction / it.predicted_reduction);
+    }
+    if (it.step == opt::IterationStep::NoPredictedReduction) {
+      EXPECT_TRUE(std::isnan(it.rho));
+    }
+    EXPECT_FALSE(it.surrogate.empty());
+    EXPECT_EQ(it.runs, 0);  // hs071 has no Monte Carlo
+  }
+  EXPECT_GT(accepted, 0);
+  EXPECT_EQ(r.iteration_records.front().radius, opt::SaoOptions{}.initial_radius);
+  EXPECT_LE(r.iteration_records.back().evaluations, r.evaluations);
+  EXPECT_EQ(opt::to_string(opt::IterationStep::NoPredictedReduction), "no_predicted_reduction");
 }
 
 // ---- options ----
@@ -285,15 +316,15 @@ TEST(SaoOptions, BadValuesNameKeyValueAndRule) {
   EXPECT_EQ(message([](auto& s) { s.initial_radius = -1; }), "sao.initial_radius = -1: must be in (0, 1]");
   EXPECT_EQ(message([](auto& s) { s.rho_expand_low = 0.2; }), "sao.rho_expand_low = 0.2: must be > rho_shrink = 0.25");
   EXPECT_EQ(message([](auto& s) { s.stall_iterations = 0; }), "sao.stall_iterations = 0: must be >= 1");
-  EXPECT_EQ(message([](auto& s) { s.surrogate = "cubic"; }),
+  EXPECT_EQ(config_error_of([] { opt::surrogate_kind_from_string("cubic"); }),
             "sao.surrogate = cubic: must be one of: auto, linear, interactions, pure_quadratic, quadratic, kriging");
-  EXPECT_EQ(message([](auto& s) { s.doe = "sobol"; }),
+  EXPECT_EQ(config_error_of([] { opt::doe_kind_from_string("sobol"); }),
             "sao.doe = sobol: must be one of: auto, koshal, axial, central_composite, lhs");
-  EXPECT_EQ(message([](auto& s) { s.subproblem_solver = "ipopt"; }),
+  EXPECT_EQ(config_error_of([] { opt::subproblem_solver_from_string("ipopt"); }),
             "sao.subproblem_solver = ipopt: must be one of: slsqp, cobyla");
   EXPECT_EQ(message([](auto& s) {
-              s.surrogate = "quadratic";
-              s.doe = "koshal";
+              s.surrogate = opt::SurrogateKind::Quadratic;
+              s.doe = opt::DoeKind::Koshal;
             }),
             "sao.doe = koshal: koshal (n+1 points) cannot determine a quadratic surrogate; use auto, axial, "
             "central_composite or lhs");
@@ -306,8 +337,8 @@ TEST(SaoOptions, ReadFromYaml) {
       "sao:\n  surrogate: quadratic\n  doe: lhs\n  initial_radius: 0.2\n  max_radius: 0.8\n  correction: false\n");
   YamlReader section = root.child("sao");
   const opt::SaoOptions s = opt::read_sao_options(section);
-  EXPECT_EQ(s.surrogate, "quadratic");
-  EXPECT_EQ(s.doe, "lhs");
+  EXPECT_EQ(s.surrogate, opt::SurrogateKind::Quadratic);
+  EXPECT_EQ(s.doe, opt::DoeKind::Lhs);
   EXPECT_DOUBLE_EQ(s.initial_radius, 0.2);
   EXPECT_DOUBLE_EQ(s.max_radius, 0.8);
   EXPECT_FALSE(s.correction);
@@ -331,6 +362,21 @@ TEST(SaoOptions, ReadFromYaml) {
   EXPECT_NE(error_of("sao:\n  radius: 0.2\n").find("sao.radius"), std::string::npos);  // unknown key
   EXPECT_EQ(error_of("sao:\n  surrogate: cubic\n"),
             "sao.surrogate = cubic: must be one of: auto, linear, interactions, pure_quadratic, quadratic, kriging");
+  EXPECT_EQ(error_of("sao:\n  subproblem_solver: ipopt\n"),
+            "sao.subproblem_solver = ipopt: must be one of: slsqp, cobyla");
+}
+
+// Every enumerator's spelling reads back as itself (to_string and from_string are inverses).
+TEST(SaoOptions, ChoicesRoundTripThroughText) {
+  for (const std::string& name : opt::surrogate_kind_names())
+    EXPECT_EQ(opt::to_string(opt::surrogate_kind_from_string(name)), name);
+  for (const std::string& name : opt::doe_kind_names()) EXPECT_EQ(opt::to_string(opt::doe_kind_from_string(name)), name);
+  for (const std::string& name : opt::intervening_kind_names())
+    EXPECT_EQ(opt::to_string(opt::intervening_kind_from_string(name)), name);
+  for (const std::string& name : opt::subproblem_solver_names())
+    EXPECT_EQ(opt::to_string(opt::subproblem_solver_from_string(name)), name);
+  EXPECT_EQ(opt::to_string(opt::SurrogateKind::PureQuadratic), "pure_quadratic");
+  EXPECT_EQ(opt::to_string(opt::DoeKind::CentralComposite), "central_composite");
 }
 
 // Every surrogate and DOE choice runs and reaches the truss optimum.
@@ -340,7 +386,7 @@ TEST(Sao, EverySurrogateChoiceWorks) {
     opt::OptimizerOptions o;
     o.max_evaluations = 300;
     opt::SaoOptions sao;
-    sao.surrogate = surrogate;
+    sao.surrogate = opt::surrogate_kind_from_string(surrogate);
     const opt::OptimizationResult r = opt::minimize_sao(*problem, o, sao);
     std::cout << "[measure] two_bar_truss " << surrogate << ": " << r.brief_report() << "\n";
     ASSERT_TRUE(r.has_feasible_point()) << surrogate;

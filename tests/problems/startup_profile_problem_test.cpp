@@ -13,7 +13,9 @@
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/core/monte_carlo.hpp"
 #include "abuopt/core/monte_carlo_stats.hpp"
+#include "abuopt/core/simulation_config.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
+#include "../common/perturb_archive.hpp"
 
 namespace {
 
@@ -284,6 +286,70 @@ TEST(StartupProfileProblem, IdentityChangesWithWhatDecidesTheValues) {
   EXPECT_NE(problems::fnv1a64("a"), problems::fnv1a64("b"));
   EXPECT_EQ(problems::fnv1a64(""), 14695981039346656037ull);  // FNV-1a offset basis
   EXPECT_EQ(problems::fnv1a64("a"), 0xaf63dc4c8601ec8cull);   // published test vector
+}
+
+// Every key of abu, profile, motor and simulation (every leaf of their field lists, so a key added
+// later is covered too) changes the problem identity: an archive never answers with evaluations of
+// another model.
+TEST(StartupProfileProblem, AnySetupKeyChangesTheIdentity) {
+  std::string yaml = kThreeStep;  // random initial conditions: a third ball keeps the runs valid
+  const std::string grid = "montecarlo: {design: grid, grid: 2, threads: 1}";
+  yaml.replace(yaml.find(grid), grid.size(), "montecarlo: {design: random, runs: 4, threads: 1}");
+  const StartupProfileSettings base = settings_from(yaml);
+  const std::string id = StartupProfileProblem(base).identity();
+  std::size_t leaves = 0;
+  for (std::size_t k = 0;; ++k) {
+    StartupProfileSettings s = base;
+    test_support::PerturbArchive a(k);
+    describe_fields(a, s.study.setup);
+    if (!a.changed()) {
+      leaves = a.leaves();
+      break;
+    }
+    std::string changed;
+    try {
+      changed = StartupProfileProblem(s).identity();
+    } catch (const ConfigError& e) {
+      ADD_FAILURE() << a.changed_path() << ": " << e.what();
+      continue;
+    }
+    EXPECT_NE(changed, id) << a.changed_path();
+  }
+  EXPECT_GE(leaves, 8u + 1 + 4 + 1 + 1 + 6 + 8 + 13);  // abu (2 balls), profile (3 segments), motor, simulation
+}
+
+// Over every section of the settings: a field is in the identity exactly when it is marked so
+// (bounds, x0, scales, threads and the validation section are not), and read -> write -> read
+// gives the same settings after any single change.
+TEST(StartupProfileProblem, SettingsRoundTripAndIdentityFollowTheFieldLists) {
+  StartupProfileSettings base = settings_from(kThreeStep + "objective: {kind: weighted, weights: {mean: 1, pct_mi: 0.5}}\n");
+  const std::string id = identity_fields(base);
+  auto round_trip = [](const StartupProfileSettings& s) {
+    const std::string yaml = write_fields(s);
+    return settings_from(yaml);
+  };
+  EXPECT_EQ(write_fields(round_trip(base)), write_fields(base));
+  std::size_t outside = 0;
+  for (std::size_t k = 0;; ++k) {
+    StartupProfileSettings s = base;
+    test_support::PerturbArchive a(k);
+    describe_fields(a, s);
+    if (!a.changed()) break;
+    outside += !a.changed_identity();
+    EXPECT_EQ(identity_fields(s) != id, a.changed_identity()) << a.changed_path();
+    StartupProfileSettings back;
+    try {
+      back = round_trip(s);
+    } catch (const ConfigError& e) {
+      // A single change may break a rule across fields (a grid size against the runs): the
+      // reader must say so, never accept it silently.
+      EXPECT_NE(std::string(e.what()).find(" = "), std::string::npos) << a.changed_path();
+      continue;
+    }
+    EXPECT_EQ(write_fields(back), write_fields(s)) << a.changed_path();
+  }
+  // threads; min, max and x0 of the 5 free values and the one scale given; 5 validation keys.
+  EXPECT_EQ(outside, 1u + 5 * 3 + 1 + 5);
 }
 
 TEST(StartupProfileProblem, ConfigErrorsNameKeyValueAndRule) {

@@ -224,6 +224,7 @@ TEST(Kriging, UsageErrors) {
               k.fit(Eigen::MatrixXd::Zero(1, 2), Eigen::VectorXd::Zero(1));
             }),
             "Kriging::fit: kriging needs at least 2 points, got 1");
+  EXPECT_THROW(k.fit(Eigen::MatrixXd::Zero(1, 2), Eigen::VectorXd::Zero(1)), InsufficientData);
   KrigingOptions fixed;
   fixed.optimize = false;
   Kriging no_scales(fixed);

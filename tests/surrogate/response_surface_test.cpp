@@ -225,6 +225,29 @@ TEST(ResponseSurface, RankDeficientDesignIsRejected) {
       << message;
 }
 
+// Data that cannot determine the model is InsufficientData (a caller tries a simpler basis);
+// inconsistent data is a plain invalid_argument (a programming error, not to be caught as the
+// first).
+TEST(ResponseSurface, InsufficientDataIsItsOwnErrorAndMisuseIsNot) {
+  const Eigen::MatrixXd X = latin_hypercube(3, {.points = 7});
+  ResponseSurface rs(Basis::kQuadratic);
+  EXPECT_THROW(rs.fit(X, Eigen::VectorXd::Ones(7)), InsufficientData);
+  const Eigen::MatrixXd f = full_factorial(2, 2);
+  Eigen::MatrixXd R(8, 2);
+  R << f, f;
+  EXPECT_THROW(rs.fit(R, Eigen::VectorXd::Ones(8)), InsufficientData);
+  bool insufficient = false, invalid = false;
+  try {
+    rs.fit(X, Eigen::VectorXd::Ones(6));  // sizes disagree
+  } catch (const InsufficientData&) {
+    insufficient = true;
+  } catch (const std::invalid_argument&) {
+    invalid = true;
+  }
+  EXPECT_FALSE(insufficient);
+  EXPECT_TRUE(invalid);
+}
+
 TEST(ResponseSurface, UsageErrors) {
   ResponseSurface rs(Basis::kLinear);
   EXPECT_THROW(rs.value(Eigen::Vector2d(0, 0)), std::logic_error);

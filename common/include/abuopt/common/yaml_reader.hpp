@@ -60,6 +60,8 @@ class YamlReader {
   std::string get_choice_or(const std::string& key, const std::string& fallback,
                             const std::vector<std::string>& choices);
   std::vector<double> get_double_list(const std::string& key, const Rule& rule = Rule::any());
+  // A list of strings (a single string counts as a list of one); absent: `fallback`.
+  std::vector<std::string> get_string_list_or(const std::string& key, const std::vector<std::string>& fallback = {});
 
   // Sub-mapping; an absent key gives an empty reader (present() == false).
   YamlReader child(const std::string& key);
@@ -67,6 +69,9 @@ class YamlReader {
   std::vector<YamlReader> children(const std::string& key);
   // Throws if the node at `key` exists but is not a sequence/mapping.
   bool is_sequence(const std::string& key) const;
+
+  // Counts `key` as read without reading it (a caller that reads it another way).
+  void mark_read(const std::string& key) { read_.insert(key); }
 
   // Throws ConfigError for the first key of this mapping that was never read.
   void finish() const;
@@ -80,6 +85,10 @@ class YamlReader {
   std::string path_;
   std::set<std::string> read_;
 };
+
+// Deep merge: a copy of `base` with `overlay` applied (maps merge recursively, anything else
+// replaces). Neither argument is modified.
+YAML::Node merge_yaml(const YAML::Node& base, const YAML::Node& overlay);
 
 // A printable form of a YAML node for error messages (scalars as written, others as flow YAML).
 std::string yaml_value_text(const YAML::Node& n);

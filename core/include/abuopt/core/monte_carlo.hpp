@@ -17,6 +17,7 @@
 #include <memory>
 #include <vector>
 
+#include "abuopt/common/config_fields.hpp"
 #include "abuopt/common/yaml_reader.hpp"
 #include "abuopt/core/batch_runner.hpp"
 #include "abuopt/core/initial_conditions.hpp"
@@ -127,5 +128,13 @@ struct MonteCarloConfig {
 // `setup` (read before, e.g. by read_simulation_setup) becomes study.setup. Validates the study.
 // The caller still calls root.finish().
 MonteCarloConfig read_monte_carlo_config(YamlReader& root, SimulationSetup setup);
+
+extern const EnumNames<InitialConditionKind> kInitialConditionKindNames;  // grid, random, lhs, halton, sobol
+
+// The keys of the `montecarlo` section (not the setup): one field list for reading, writing,
+// validation and identity. `threads` is not part of the identity (results do not depend on it);
+// the design's seed is (it equals `seed` when read, and may differ in a study built in code).
+void describe_montecarlo_fields(FieldArchive& a, MonteCarloStudy& study, std::size_t& threads);
+void describe_fields(FieldArchive& a, MonteCarloConfig& c);
 
 }  // namespace abuopt

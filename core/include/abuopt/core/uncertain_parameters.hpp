@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "abuopt/common/config_fields.hpp"
 #include "abuopt/common/yaml_reader.hpp"
 #include "abuopt/core/parameters.hpp"
 #include "abuopt/core/simulator.hpp"
@@ -66,6 +67,12 @@ void validate(const UncertainParameters& u, const std::string& path = "montecarl
 // range. Pure function of its arguments.
 RunOverrides sample_overrides(const UncertainParameters& u, const AbuParameters& nominal, std::uint64_t seed,
                               std::size_t index);
+
+extern const EnumNames<ImbalanceAngleSampling> kImbalanceAngleNames;  // fixed, uniform
+
+// The keys `friction` and `imbalance` of the `montecarlo` section (one field list: reading,
+// writing, validation, identity).
+void describe_fields(FieldArchive& a, UncertainParameters& u);
 
 // Reads the uncertain parameters from the `montecarlo` section (keys `friction`, `imbalance`):
 //   friction: {fixed: 0.02} | {list: [0.02, 0.03]} | {range: [0.02, 0.04]}   (absent: nominal)

@@ -5,7 +5,7 @@
 
 namespace abuopt::opt {
 
-enum class AlgorithmFamily { local_derivative_free, local_gradient, global, meta };
+enum class AlgorithmFamily { LocalDerivativeFree, LocalGradient, Global, Meta };
 
 struct AlgorithmInfo {
   std::string name;            // canonical upper-case name, e.g. "SLSQP"

@@ -6,6 +6,7 @@
 // Ctrl-C, an exception inside an evaluation). A run reports success() only if it converged AND
 // its best point is feasible: an optimiser that claims convergence at an infeasible point is
 // reported with reason `infeasible`.
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -16,25 +17,25 @@
 namespace abuopt::opt {
 
 enum class TerminationReason {
-  converged,            // the algorithm's own convergence test (no finer reason given)
-  converged_ftol,       // change of f below ftol_rel / ftol_abs
-  converged_xtol,       // change of x below xtol_rel (or Ipopt: search direction too small)
-  target_reached,       // a feasible point with f <= target
-  max_evaluations,      // evaluation budget used up
-  max_iterations,       // iteration limit (Ipopt)
-  max_time,             // wall-clock (or Ipopt CPU) limit
-  stopped_by_callback,  // the evaluation callback returned false
-  interrupted,          // SIGINT (Ctrl-C) or request_stop()
-  evaluation_error,     // an evaluation threw an exception
-  infeasible,           // the algorithm stopped without a feasible point
-  roundoff_limited,     // NLopt: roundoff errors limited progress
-  failure,              // the algorithm failed (message says why)
+  Converged,           // the algorithm's own convergence test (no finer reason given)
+  ConvergedFtol,       // change of f below ftol_rel / ftol_abs
+  ConvergedXtol,       // change of x below xtol_rel (or Ipopt: search direction too small)
+  TargetReached,       // a feasible point with f <= target
+  MaxEvaluations,      // evaluation budget used up
+  MaxIterations,       // iteration limit (Ipopt)
+  MaxTime,             // wall-clock (or Ipopt CPU) limit
+  StoppedByCallback,   // the evaluation callback returned false
+  Interrupted,         // SIGINT (Ctrl-C) or request_stop()
+  EvaluationError,     // an evaluation threw an exception
+  Infeasible,          // the algorithm stopped without a feasible point
+  RoundoffLimited,     // NLopt: roundoff errors limited progress
+  Failure,             // the algorithm failed (message says why)
 };
 
 std::string to_string(TerminationReason reason);
 // Inverse of to_string; throws abuopt::ConfigError listing the valid names.
 TerminationReason termination_reason_from_string(const std::string& text);
-// converged, converged_ftol, converged_xtol, target_reached.
+// Converged, ConvergedFtol, ConvergedXtol, TargetReached.
 bool is_convergence(TerminationReason reason);
 
 // One evaluation as the optimiser saw it.
@@ -55,10 +56,40 @@ struct EvaluationRecord {
   std::string message;
 };
 
+// What one iteration of a trust-region method (SAO) did.
+enum class IterationStep {
+  Accepted,              // the candidate became the centre
+  Rejected,              // the candidate was no better than the centre: the centre stays
+  NoPredictedReduction,  // the surrogates saw no better point in the region: no candidate
+  NoModel,               // no surrogate could be fitted (e.g. every point failed)
+};
+std::string to_string(IterationStep step);
+
+// One iteration of a trust-region method (SAO; sao.hpp): the numbers of its ratio test. NaN where
+// the iteration did not get that far (no candidate: no actual reduction, no rho).
+struct IterationRecord {
+  long iteration = 0;                // 1-based
+  IterationStep step = IterationStep::NoModel;
+  long evaluations = 0;              // evaluations of the run at the end of the iteration
+  double radius = 0.0;               // trust-region radius of the iteration (fraction of each range)
+  double next_radius = 0.0;          // after the ratio test
+  double predicted_reduction = std::numeric_limits<double>::quiet_NaN();  // of the merit, by the surrogates
+  double actual_reduction = std::numeric_limits<double>::quiet_NaN();     // of the merit, evaluated
+  double rho = std::numeric_limits<double>::quiet_NaN();                  // actual / predicted
+  double noise = 0.0;                // noise level of the merit the ratio test allowed for (0: none)
+  double step_length = std::numeric_limits<double>::quiet_NaN();  // |s|_inf of the candidate (1: boundary)
+  double penalty = 0.0;              // penalty weight mu of the merit after the iteration
+  double centre_merit = 0.0;         // merit of the centre after the iteration
+  bool feasibility_phase = false;    // the merit was the violation alone
+  long runs = 0;                     // the centre's metric "runs" (Monte Carlo runs; 0 without it)
+  std::string surrogate;             // basis fitted, e.g. "quadratic"
+  std::string forms;                 // intervening form per response, e.g. "f:l g:r"
+};
+
 struct OptimizationResult {
   std::string problem_name;
   std::string algorithm;           // as run, e.g. "AUGLAG(BOBYQA)"
-  TerminationReason reason = TerminationReason::failure;
+  TerminationReason reason = TerminationReason::Failure;
   std::string message;             // human-readable detail of the reason
 
   // Best point: the feasible point with the lowest objective; if no point was feasible, the
@@ -79,13 +110,16 @@ struct OptimizationResult {
   long gradient_evaluations = 0;   // of which finite-difference neighbours
   long repeated_requests = 0;      // in-run repeats answered from memory (not counted above)
   long clipped_requests = 0;       // requests outside the bounds that were clipped into them
-  long iterations = 0;             // Ipopt iterations; 0 for NLopt
+  long iterations = 0;             // Ipopt and SAO iterations; 0 for NLopt
   double wall_time_s = 0.0;
 
   std::vector<std::string> variable_names;
   std::vector<std::string> inequality_names;
   std::vector<std::string> equality_names;
   std::vector<EvaluationRecord> history;  // every evaluation, in order (if keep_history)
+  // SAO: one record per iteration (radius, rho, predicted and actual reduction, noise, runs); empty
+  // for the other algorithms. `iterations` above is their count for SAO.
+  std::vector<IterationRecord> iteration_records;
 
   // Converged and the best point is feasible.
   bool success() const;

@@ -14,8 +14,11 @@
 
 namespace abuopt::opt {
 
-enum class FiniteDifference { forward, central };
-std::string to_string(FiniteDifference kind);
+enum class FiniteDifference { Forward, Central };
+std::string to_string(FiniteDifference kind);  // "forward", "central"
+// Inverse of to_string; throws abuopt::ConfigError naming `key`, the value and the valid names.
+FiniteDifference finite_difference_from_string(const std::string& text,
+                                               const std::string& key = "optimizer.finite_difference");
 
 struct OptimizerOptions {
   // Algorithm name, case-insensitive (COBYLA, BOBYQA, SLSQP, IPOPT, SAO, ...; algorithm_names()).
@@ -48,7 +51,7 @@ struct OptimizerOptions {
 
   // Finite-difference gradients (gradient-based algorithms and Ipopt): forward costs n extra
   // evaluations per gradient, central 2n and is more accurate.
-  FiniteDifference finite_difference = FiniteDifference::forward;
+  FiniteDifference finite_difference = FiniteDifference::Forward;
   // Relative step h: the step for x_i is h * max(|x_i|, scale_i). 0: sqrt(machine epsilon)
   // (1.5e-8) for forward, cbrt(machine epsilon) (6.1e-6) for central. Noisy objectives (Monte
   // Carlo) need a step well above the noise, e.g. 1e-3.

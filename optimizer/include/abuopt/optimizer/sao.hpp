@@ -4,7 +4,7 @@
 // OptimizationResult as minimize().
 //
 //   abuopt::opt::OptimizerOptions o;  o.max_evaluations = 200;
-//   abuopt::opt::SaoOptions sao;       sao.surrogate = "auto";
+//   abuopt::opt::SaoOptions sao;       sao.surrogate = abuopt::opt::SurrogateKind::Auto;
 //   abuopt::opt::OptimizationResult r = abuopt::opt::minimize_sao(problem, o, sao);
 //
 // One iteration, in the unit box z = (x - lower) / (upper - lower) (every variable scaled to its
@@ -43,12 +43,13 @@
 //   OptimizerOptions::max_iterations iterations (max_iterations; 0: no limit);
 //   OptimizerOptions::max_evaluations / max_time_s / target / SIGINT / callback as in minimize().
 // Like every optimiser, success() only if converged AND the best point is feasible.
+// OptimizationResult::iteration_records holds one record per iteration (radius before and after,
+// predicted and actual reduction, rho, the noise level allowed for, penalty weight, run count).
 //
 // SAO is an algorithm of minimize() like any other: `algorithm: SAO` (any case) runs it with
 // OptimizerOptions::sao, through the same evaluation wrapper, SIGINT handling and result
 // building. Options used besides `sao`: max_evaluations, max_time_s, max_iterations, target,
 // constraint_tolerance, seed (LHS), handle_sigint, keep_history.
-#include <string>
 #include <vector>
 
 #include "abuopt/optimizer/minimize.hpp"
@@ -61,15 +62,6 @@ namespace abuopt::opt {
 // invalid options, an invalid problem or starting point. Once evaluations start it never throws:
 // everything else is a TerminationReason. The result's algorithm is "SAO(<surrogate>)".
 OptimizationResult minimize_sao(Problem& problem, const OptimizerOptions& options, const SaoOptions& sao,
-                                std::vector<double> x0 = {}, const EvaluationCallback& callback = {});
-
-// true for "SAO" (case-insensitive): how a caller dispatches between minimize() and
-// minimize_sao() by algorithm name.
-bool is_sao_algorithm(const std::string& name);
-
-// For callers that hold the SAO options apart from the OptimizerOptions: minimize_sao() with `sao`
-// when options.algorithm is SAO, else minimize(problem, options) (`sao` unused).
-OptimizationResult minimize_any(Problem& problem, const OptimizerOptions& options, const SaoOptions& sao = {},
                                 std::vector<double> x0 = {}, const EvaluationCallback& callback = {});
 
 }  // namespace abuopt::opt

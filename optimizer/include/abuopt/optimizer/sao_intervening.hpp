@@ -25,13 +25,11 @@
 
 #include <Eigen/Dense>
 
+#include "abuopt/optimizer/sao_options.hpp"
 #include "abuopt/surrogate/response_surface.hpp"
 #include "abuopt/surrogate/surrogate.hpp"
 
 namespace abuopt::opt {
-
-// "auto", "linear", "reciprocal", "exponential".
-const std::vector<std::string>& intervening_choices();
 
 // true when variable bounds allow x^p and ln x: lower > 0 (finite).
 bool intervening_allowed(double lower, double upper);
@@ -98,7 +96,7 @@ struct InterveningData {
 
 // The chosen form of one response and its fitted model.
 struct InterveningChoice {
-  std::string form = "linear";  // linear, reciprocal or exponential (never auto)
+  InterveningKind form = InterveningKind::Linear;  // Linear, Reciprocal or Exponential (never Auto)
   Eigen::VectorXd exponents;    // p (1 for linear)
   double loo_error = 0;         // weighted_press() of the choice (+inf: not measurable)
   std::unique_ptr<InterveningSurrogate> model;
@@ -111,9 +109,9 @@ struct InterveningChoice {
 // `previous` choice of this response is kept (its form and exponents), else linear. auto prefers
 // linear: reciprocal only when its error is below 1/4 of the linear one, exponential only when its
 // error is below 1/50 of the better fixed form (it has n fitted exponents more). The final model
-// has `basis`. Throws std::invalid_argument when the basis cannot be fitted (too few points,
+// has `basis`. Throws surrogate::InsufficientData when the basis cannot be fitted (too few points,
 // rank-deficient).
-InterveningChoice fit_intervening(const std::string& requested, surrogate::Basis basis, const InterveningData& data,
+InterveningChoice fit_intervening(InterveningKind requested, surrogate::Basis basis, const InterveningData& data,
                                   const Eigen::VectorXd& y, const InterveningChoice* previous = nullptr);
 
 }  // namespace abuopt::opt

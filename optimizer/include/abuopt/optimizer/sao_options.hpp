@@ -6,7 +6,9 @@
 //   optimizer:
 //     algorithm: SAO
 //     sao: {initial_radius: 0.2, doe_points_factor: 2}
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "abuopt/common/yaml_reader.hpp"
 
@@ -14,11 +16,34 @@ namespace abuopt::opt {
 
 class EvaluationArchive;  // evaluation_archive.hpp
 
+// The choices of SAO, parsed once when read. to_string gives the YAML spelling (snake_case, e.g.
+// "pure_quadratic"); <name>_from_string is its inverse and throws abuopt::ConfigError naming `key`,
+// the value and the valid spellings ("sao.doe = sobol: must be one of: auto, koshal, ...").
+enum class SurrogateKind { Auto, Linear, Interactions, PureQuadratic, Quadratic, Kriging };
+enum class DoeKind { Auto, Koshal, Axial, CentralComposite, Lhs };
+enum class InterveningKind { Auto, Linear, Reciprocal, Exponential };
+enum class SubproblemSolver { Slsqp, Cobyla };
+
+std::string to_string(SurrogateKind kind);
+std::string to_string(DoeKind kind);
+std::string to_string(InterveningKind kind);
+std::string to_string(SubproblemSolver solver);
+SurrogateKind surrogate_kind_from_string(const std::string& text, const std::string& key = "sao.surrogate");
+DoeKind doe_kind_from_string(const std::string& text, const std::string& key = "sao.doe");
+InterveningKind intervening_kind_from_string(const std::string& text, const std::string& key = "sao.intervening");
+SubproblemSolver subproblem_solver_from_string(const std::string& text,
+                                               const std::string& key = "sao.subproblem_solver");
+// The spellings of every enumerator, in declaration order.
+const std::vector<std::string>& surrogate_kind_names();
+const std::vector<std::string>& doe_kind_names();
+const std::vector<std::string>& intervening_kind_names();
+const std::vector<std::string>& subproblem_solver_names();
+
 struct SaoOptions {
   // Surrogate of the objective and of every constraint: auto, linear, interactions,
   // pure_quadratic, quadratic, kriging. auto: the richest of quadratic > pure_quadratic > linear
   // that the points of the region support.
-  std::string surrogate = "auto";
+  SurrogateKind surrogate = SurrogateKind::Auto;
   // Candidate DOE in the region: auto, koshal, axial, central_composite, lhs.
   // auto (with doe_points 0, doe_points_factor 1 and a response surface): no design per region;
   // every evaluated point joins the fit and points are added only where the fit zone lacks spread
@@ -26,7 +51,7 @@ struct SaoOptions {
   // design, a point count, a factor > 1 or kriging) each region is filled with the design:
   // koshal for a linear surrogate, axial (centre and +-r on each axis) then the corners of a
   // central composite design for the quadratic ones, lhs for kriging.
-  std::string doe = "auto";
+  DoeKind doe = DoeKind::Auto;
   // Points wanted in the region before fitting (designs per region only); 0: automatic (linear:
   // n+1, interactions: its term count, pure_quadratic / auto / kriging: 2n+1, quadratic:
   // (n+1)(n+2)/2).
@@ -65,10 +90,10 @@ struct SaoOptions {
   // fit zone (1/4, resp. 1/50 of it; docs/sao.md). A variable whose lower
   // bound is <= 0 always stays linear. Response surfaces only (kriging: reciprocal if asked, else
   // linear). auto, linear, reciprocal, exponential.
-  std::string intervening = "auto";
-  // Overrides for the objective and for every constraint ("": as `intervening`).
-  std::string intervening_objective;
-  std::string intervening_constraints;
+  InterveningKind intervening = InterveningKind::Auto;
+  // Overrides for the objective and for every constraint (none: as `intervening`).
+  std::optional<InterveningKind> intervening_objective;
+  std::optional<InterveningKind> intervening_constraints;
 
   // Zeroth-order additive correction (Dakota's `correction additive zeroth_order`): every
   // surrogate is shifted to match the true value at the centre.
@@ -96,7 +121,7 @@ struct SaoOptions {
   double stall_tolerance = 1e-8;  // >= 0
 
   // Sub-problem solver: slsqp (NLopt SLSQP, surrogate gradients) or cobyla (NLopt COBYLA).
-  std::string subproblem_solver = "slsqp";
+  SubproblemSolver subproblem_solver = SubproblemSolver::Slsqp;
   int subproblem_max_evaluations = 500;  // per start; >= 10
   // Kriging nugget (relative to the process variance); raise it (e.g. 1e-2) for noisy problems.
   double kriging_nugget = 1e-8;

@@ -48,6 +48,7 @@
 #include <string_view>
 #include <vector>
 
+#include "abuopt/common/config_fields.hpp"
 #include "abuopt/common/yaml_reader.hpp"
 #include "abuopt/core/initial_conditions.hpp"
 #include "abuopt/core/monte_carlo.hpp"
@@ -76,16 +77,19 @@ struct ProfileDesign {
   std::vector<SegmentDesign> segments;
 };
 
-enum class ObjectiveKind { mean, pct_mi, weighted };
-enum class ImbalanceDefinition { magnitude, report_x };
-enum class AmplitudeStatistic { max, mean };
+enum class ObjectiveKind { Mean, PctMi, Weighted };
+enum class ImbalanceDefinition { Magnitude, ReportX };
+enum class AmplitudeStatistic { Max, Mean };
+extern const EnumNames<ObjectiveKind> kObjectiveKindNames;              // mean, pct_mi, weighted
+extern const EnumNames<ImbalanceDefinition> kImbalanceDefinitionNames;  // magnitude, report_x
+extern const EnumNames<AmplitudeStatistic> kAmplitudeStatisticNames;    // max, mean
 std::string to_string(ObjectiveKind k);
 std::string to_string(ImbalanceDefinition d);
 std::string to_string(AmplitudeStatistic a);
 
 struct ObjectiveSettings {
-  ObjectiveKind kind = ObjectiveKind::mean;
-  ImbalanceDefinition definition = ImbalanceDefinition::magnitude;
+  ObjectiveKind kind = ObjectiveKind::Mean;
+  ImbalanceDefinition definition = ImbalanceDefinition::Magnitude;
   double weight_mean = 1.0;    // weighted: per 1e-7 kg m of mean I_r
   double weight_pct_mi = 0.0;  // weighted: per percent of %MI
   // Robust objective: average over these friction coefficients; empty: one pass with the
@@ -98,7 +102,7 @@ struct ObjectiveSettings {
 struct ConstraintSettings {
   std::optional<double> max_startup_time_s;
   std::optional<double> max_amplitude_mm;
-  AmplitudeStatistic amplitude = AmplitudeStatistic::max;
+  AmplitudeStatistic amplitude = AmplitudeStatistic::Max;
   std::optional<double> max_pct_mi;
   double penalty_weight = 0.0;  // > 0: optimised in penalty form (make_startup_profile_problem)
 };
@@ -122,6 +126,17 @@ struct StartupProfileSettings {
   ConstraintSettings constraints;
   ValidationSettings validation;
 };
+
+// The field lists of the sections (common/config_fields.hpp): reading, writing, validation and the
+// problem identity all come from them. The design's absent segment values come from the profile
+// template; the validation section's defaults from the montecarlo section.
+void describe_fields(FieldArchive& a, ObjectiveSettings& o);
+void describe_fields(FieldArchive& a, ConstraintSettings& c);
+void describe_design_fields(FieldArchive& a, ProfileDesign& d, const StartupProfile& profile_template);
+void describe_validation_fields(FieldArchive& a, ValidationSettings& v, const MonteCarloStudy& study);
+// Every section of the settings: abu, profile, motor, simulation, montecarlo, design, objective,
+// constraints, validation.
+void describe_fields(FieldArchive& a, StartupProfileSettings& s);
 
 // Reads the sections abu, profile, motor, simulation, montecarlo, design, objective, constraints
 // and validation of `root` (docs/optimize.md lists every key). Leaves the other sections (optimizer,
@@ -164,10 +179,11 @@ class StartupProfileProblem : public opt::Problem {
   // The validation set of the settings as (design, runs, seed) for evaluate_profile.
   opt::Evaluation evaluate_out_of_sample(const StartupProfile& profile) const;
 
-  // Everything that decides the value of evaluate(x) as canonical text: the resolved setup
-  // (to_yaml), the fixed values and the order of the free variables, the Monte Carlo sampling, the
-  // objective and the constraints. Not in it (changing them keeps archived evaluations valid):
-  // bounds, x0, scales, threads, validation, optimizer settings.
+  // Everything that decides the value of evaluate(x) as canonical text, derived from the field
+  // lists (identity_fields of the settings): every key of abu, profile, motor, simulation, the
+  // Monte Carlo sampling, the fixed values and the order of the free variables, the objective and
+  // the constraints. Not in it (changing them keeps archived evaluations valid): bounds, x0,
+  // scales, threads, the validation section, optimizer settings.
   std::string identity_text() const;
   // "startup_profile-<16 hex digits of fnv1a64(identity_text())>": the archive's problem id.
   std::string identity() const;

@@ -103,10 +103,6 @@ struct ReproductionTable {
   const ReproductionCase* find_case(const std::string& case_id) const;  // nullptr if absent
 };
 
-// Deep merge: a copy of `base` with `overlay` applied (maps merge recursively, anything else
-// replaces). Neither argument is modified.
-YAML::Node merge_yaml(const YAML::Node& base, const YAML::Node& overlay);
-
 // Reads one table file; throws ConfigError ("<file>: cases[3] (dt4): profile.segments[0]... ").
 ReproductionTable read_reproduction_table(const std::string& file);
 // The same from YAML text (tests); `name` stands in for the file name in messages.

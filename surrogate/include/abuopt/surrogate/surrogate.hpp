@@ -7,11 +7,13 @@
 //   double f = model->value(x);       // x: one point, x.size() == X.cols()
 //   Eigen::VectorXd g = model->gradient(x);
 //
-// Errors: fit() with inconsistent or insufficient data throws std::invalid_argument;
+// Errors: fit() with inconsistent or insufficient data throws std::invalid_argument (data that
+// cannot determine the model, too few points or a rank-deficient design, as InsufficientData);
 // value()/gradient() before fit() throw std::logic_error; a point of the wrong size throws
 // std::invalid_argument ("the surrogate was fitted in 3 variables, x has 2").
 
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -20,6 +22,14 @@
 namespace abuopt::surrogate {
 
 struct KrigingOptions;  // kriging.hpp
+
+// fit() on data that cannot determine the model: fewer points than terms, a rank-deficient design,
+// a correlation matrix that no nugget makes positive definite. Valid data, just not enough of it:
+// a caller that tries a simpler model next catches this one (and nothing else).
+class InsufficientData : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
 
 class Surrogate {
  public:

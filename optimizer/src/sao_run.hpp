@@ -1,0 +1,186 @@
+#pragma once
+// Internal: the state and steps of one SAO run (sao.hpp describes the algorithm). The steps live
+// in their own files: sao.cpp (the iteration loop, the ratio test, points), sao_design.cpp (the
+// points of a region), sao_models.cpp (the surrogates), sao_subproblem.cpp (the sub-problem and the
+// penalty), sao_noise.cpp (the noise estimate of the ratio test).
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "abuopt/optimizer/optimization_result.hpp"
+#include "abuopt/optimizer/optimizer_options.hpp"
+#include "abuopt/optimizer/sao_intervening.hpp"
+#include "abuopt/surrogate/surrogate.hpp"
+#include "evaluation_driver.hpp"
+#include "sao_noise.hpp"
+
+namespace abuopt::opt::detail {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// One known point (evaluated in this run, or taken from an archive).
+struct KnownPoint {
+  Eigen::VectorXd z;  // unit box
+  double f = kInf;
+  std::vector<double> g, h;
+  bool ok = false;
+  double l1_violation = kInf;  // sum max(0, g) + sum |h|
+  double runs = 0;             // the evaluation's metric "runs" (Monte Carlo runs), 0 without it
+};
+
+// The surrogates of one iteration, in local coordinates s, each plus an additive offset (the
+// zeroth-order correction that makes it match the true value at the centre).
+struct Models {
+  std::unique_ptr<surrogate::Surrogate> fm;
+  std::vector<std::unique_ptr<surrogate::Surrogate>> gm, hm;
+  double f_offset = 0;
+  std::vector<double> g_offset, h_offset;
+  std::string basis;
+  std::string forms;  // intervening form per response, one letter each (l, r, e): "f:l g:r"
+  // Noise level of every response (objective, inequalities, equalities) seen by this fit: the
+  // weighted residual RMS of the least-squares fit with the degrees-of-freedom correction
+  // sqrt(sum w e^2 / sum w * m / (m - p)); 0 when the fit interpolates (m <= p) or for kriging.
+  // An upper bound of the noise (it includes the lack of fit, which vanishes as r shrinks on a
+  // smooth response and does not on a noisy one).
+  std::vector<double> noise;
+  // The same residual RMS relative to the responses' weighted standard deviation on the fit zone
+  // (1: the model explains nothing; ~0: smooth at this scale).
+  std::vector<double> noise_fraction;
+  // Back-off of every inequality in the sub-problem (g^ + margin <= 0): kappa times its confirmed
+  // noise level, so that a candidate aims inside the noisy band of the bound instead of on it
+  // (set by solve_subproblem; 0 without confirmed noise).
+  std::vector<double> g_margin;
+
+  std::size_t n_g() const { return gm.size(); }
+  std::size_t n_h() const { return hm.size(); }
+  double f(const Eigen::VectorXd& s) const { return fm->value(s) + f_offset; }
+  double g(std::size_t i, const Eigen::VectorXd& s) const { return gm[i]->value(s) + g_offset[i]; }
+  double h(std::size_t j, const Eigen::VectorXd& s) const { return hm[j]->value(s) + h_offset[j]; }
+  Eigen::VectorXd f_grad(const Eigen::VectorXd& s) const { return fm->gradient(s); }
+  Eigen::VectorXd g_grad(std::size_t i, const Eigen::VectorXd& s) const { return gm[i]->gradient(s); }
+  Eigen::VectorXd h_grad(std::size_t j, const Eigen::VectorXd& s) const { return hm[j]->gradient(s); }
+
+  double l1(const Eigen::VectorXd& s) const {
+    double v = 0;
+    for (std::size_t i = 0; i < n_g(); ++i) v += std::max(0.0, g(i, s));
+    for (std::size_t j = 0; j < n_h(); ++j) v += std::fabs(h(j, s));
+    return v;
+  }
+  double max_violation(const Eigen::VectorXd& s) const {
+    double v = 0;
+    for (std::size_t i = 0; i < n_g(); ++i) v = std::max(v, g(i, s));
+    for (std::size_t j = 0; j < n_h(); ++j) v = std::max(v, std::fabs(h(j, s)));
+    return v;
+  }
+};
+
+// The trust region in local coordinates s = (z - z_c) / r: [lo, hi] = ([max(0, z_c - r),
+// min(1, z_c + r)] - z_c) / r, the box [-1, 1]^n clipped to the unit box of the bounds.
+struct RegionBox {
+  Eigen::VectorXd lo, hi;
+};
+
+class SaoRun {
+ public:
+  SaoRun(Problem& problem, const OptimizerOptions& options, const SaoOptions& sao, EvaluationDriver& driver)
+      : options_(options), sao_(sao), driver_(driver), variables_(problem.variables()) {
+    n_ = static_cast<int>(variables_.size());
+    m_ineq_ = driver.n_inequality();
+    m_eq_ = driver.n_equality();
+  }
+
+  TerminationReason reason = TerminationReason::Failure;
+  std::string message;
+  long iterations = 0;
+  std::vector<IterationRecord> records;  // one per iteration
+
+  void run(const std::vector<double>& x0);
+
+ private:
+  // ---- coordinates ----
+  Eigen::VectorXd to_z(const std::vector<double>& x) const {
+    Eigen::VectorXd z(n_);
+    for (int i = 0; i < n_; ++i) {
+      const Variable& v = variables_[i];
+      z[i] = std::clamp((x[i] - v.lower) / (v.upper - v.lower), 0.0, 1.0);
+    }
+    return z;
+  }
+  std::vector<double> to_y(const Eigen::VectorXd& z) const {  // driver coordinates x / scale
+    std::vector<double> y(n_);
+    for (int i = 0; i < n_; ++i) {
+      const Variable& v = variables_[i];
+      const double x = std::clamp(v.lower + z[i] * (v.upper - v.lower), v.lower, v.upper);
+      y[i] = x / v.scale;
+    }
+    return y;
+  }
+  Eigen::VectorXd to_s(const Eigen::VectorXd& z) const { return (z - centre_z_) / radius_; }
+  Eigen::VectorXd from_s(const Eigen::VectorXd& s) const {
+    return (centre_z_ + radius_ * s).cwiseMax(0.0).cwiseMin(1.0);
+  }
+  bool in_region(const Eigen::VectorXd& z, double factor = 1.0) const {
+    return ((z - centre_z_).cwiseAbs().maxCoeff()) <= factor * radius_ * (1 + 1e-9);
+  }
+  // The current trust region in local coordinates (the one place it is computed).
+  RegionBox region_box() const;
+
+  // ---- points (sao.cpp) ----
+  // Evaluates z on the true problem; the index into known_, or nullopt once the run is stopped.
+  std::optional<std::size_t> evaluate(const Eigen::VectorXd& z);
+  KnownPoint make_point(const Eigen::VectorXd& z, const Evaluation& e) const;
+  double merit(const KnownPoint& p) const {
+    if (!p.ok) return kInf;
+    return feasibility_phase_ ? p.l1_violation : p.f + mu_ * p.l1_violation;
+  }
+  void load_archive();
+
+  // ---- the points of a region (sao_design.cpp) ----
+  int wanted_points(SurrogateKind basis) const;
+  bool fill_region(SurrogateKind basis);  // false: stopped
+  bool minimal_design() const;
+  bool repair_geometry();  // false: stopped
+
+  // ---- surrogates (sao_models.cpp) ----
+  std::optional<Models> fit(SurrogateKind requested);
+  std::unique_ptr<surrogate::Surrogate> make_model(SurrogateKind basis) const;
+
+  // ---- sub-problem and penalty (sao_subproblem.cpp) ----
+  Eigen::VectorXd solve_subproblem(Models& models, bool& feasibility_phase);
+  Eigen::VectorXd run_nlopt(const Models& models, bool feasibility_phase, const Eigen::VectorXd& start,
+                            const RegionBox& box) const;
+  void update_penalty(const Models& models, const Eigen::VectorXd& s);
+
+  // ---- noise (sao_noise.cpp does the arithmetic) ----
+  double merit_noise(const Models& models, bool phase1) const;
+
+  const OptimizerOptions& options_;
+  const SaoOptions& sao_;
+  EvaluationDriver& driver_;
+  std::vector<Variable> variables_;
+  int n_ = 0;
+  std::size_t m_ineq_ = 0, m_eq_ = 0;
+
+  std::vector<KnownPoint> known_;
+  std::map<const EvaluatedPoint*, std::size_t> by_driver_point_;
+  Eigen::VectorXd centre_z_;
+  std::size_t centre_ = 0;
+  double radius_ = 0.1;
+  double mu_ = 1.0;
+  bool feasibility_phase_ = false;
+  // the last intervening choice of every response (objective, inequalities, equalities; no
+  // model): kept when too few points exist to compare the forms again
+  std::vector<InterveningChoice> last_choice_;
+  // which residual noise levels are noise, not lack of fit
+  NoiseConfirmation noise_confirmation_;
+};
+
+}  // namespace abuopt::opt::detail
