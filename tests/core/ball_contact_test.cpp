@@ -175,3 +175,4 @@ void no_final_overlap(std::uint64_t seed, int n, int balls) {
 
 TEST(BallContact, NoFinalStateOverlapsTwoBalls) { no_final_overlap(101, 96, 2); }
 TEST(BallContact, NoFinalStateOverlapsFourBalls) { no_final_overlap(202, 48, 4); }
+
