@@ -1,8 +1,11 @@
 // abuopt: design optimisation of startup profiles for Automatic Balancing Units.
 #include <exception>
+#include <filesystem>
+#include <new>
 #include <iostream>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/common/output_file.hpp"
 #include "commands/commands.hpp"
 
 namespace abuopt::app {
@@ -17,7 +20,12 @@ int main(int argc, char** argv) {
   CLI::App app{
       "abuopt: simulate an Automatic Balancing Unit (ABU) during startup, evaluate startup profiles\n"
       "by Monte Carlo over initial ball positions, and optimise them.\n"
-      "Every study is a YAML config (see configs/ and docs/config.md)."};
+      "Every study is a YAML config (see configs/ and docs/config.md).\n"
+      "Exit status of every command: 0 ok; 2 bad input (config, option or value; the message names the\n"
+      "key, value and rule); 3 the computation gave no usable result (every run failed, no feasible\n"
+      "design, an evaluation error ended it, out of memory); 4 an output file could not be written (disk\n"
+      "full, no permission: nothing half-written is left under its name); 130 interrupted (Ctrl-C).\n"
+      "docs/security.md says what abuopt trusts, where it writes and how it runs gnuplot."};
   app.require_subcommand(1);
   app.set_version_flag("--version", "abuopt 0.1.0");
   abuopt::app::register_simulate(app);
@@ -41,9 +49,19 @@ int main(int argc, char** argv) {
   } catch (const abuopt::ConfigError& e) {
     std::cerr << "abuopt: error: " << e.what() << "\n";
     return 2;
+  } catch (const abuopt::OutputError& e) {
+    std::cerr << "abuopt: error: " << e.what() << "\n";
+    return 4;
+  } catch (const std::filesystem::filesystem_error& e) {
+    std::cerr << "abuopt: error: " << e.what() << "\n";
+    return 4;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "abuopt: error: out of memory (the request needs more memory than is available; ask for fewer "
+                 "runs, a coarser grid or a longer trajectory interval)\n";
+    return 3;
   } catch (const std::exception& e) {
-    std::cerr << "abuopt: internal error: " << e.what() << "\n";
-    return 1;
+    std::cerr << "abuopt: error: the computation failed: " << e.what() << "\n";
+    return 3;
   }
   return abuopt::app::exit_code();
 }

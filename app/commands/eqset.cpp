@@ -14,8 +14,10 @@
 #include <nlohmann/json.hpp>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/common/output_file.hpp"
 #include "abuopt/common/config_fields.hpp"
 #include "abuopt/common/gnuplot.hpp"
+#include "abuopt/core/equilibrium_residual.hpp"
 #include "abuopt/core/equilibrium_set.hpp"
 #include "abuopt/core/simulation_config.hpp"
 #include "commands/commands.hpp"
@@ -27,6 +29,8 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr long kMaxGrid = 4096;
+// The steady amplitude grows with (2 pi f)^4 terms: 1e6 Hz keeps every product finite.
+constexpr double kMaxFrequencyHz = 1e6;
 constexpr std::size_t kMaxScanPoints = 100000;
 
 struct EqsetArgs {
@@ -126,8 +130,7 @@ int run_single(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig&
   const fs::path dir = make_out_dir(a.out.empty() ? "results/eqset-" + num_text(freq) + "Hz" : a.out, "--out");
   const fs::path csv = dir / "equilibrium_set.csv";
   {
-    std::ofstream f(csv);
-    if (!f) throw ConfigError("--out", dir.string(), "must be writable (" + csv.string() + ")");
+    AtomicFile f(csv);
     f << "beta1_rad,beta2_rad,amplitude_mm,in_set";
     for (std::size_t b = 0; b < nb; ++b) f << ",margin_" << b + 1;
     f << "\n" << std::setprecision(10);
@@ -138,6 +141,7 @@ int run_single(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig&
         for (std::size_t b = 0; b < nb; ++b) f << "," << g.margins[k * nb + b];
         f << "\n";
       }
+    f.commit();
   }
   double in_min = INFINITY, in_max = -INFINITY;
   for (std::size_t k = 0; k < n * n; ++k)
@@ -197,19 +201,64 @@ int run_single(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig&
   return 0;
 }
 
+// Residual-imbalance columns of the scan (docs/equilibrium_sets.md section 4), I_r in 1e-7 kg m.
+constexpr double kIrUnit = 1e-7;
+
+const char* kResidualHeader =
+    "frequency_hz,coverage,inscribed_ir,set_ir_min,set_ir_median,set_ir_mean,set_ir_max,set_irx_min,"
+    "set_irx_median,set_irx_max,balance_fraction,balance_ir_min,balance_ir_median,balance_ir_max,balance_irx_median,"
+    "boundary_ir_min,boundary_ir_median,boundary_ir_max,boundary_irx_median";
+
+double ir_units(double kgm) { return kgm / kIrUnit; }
+
+// One row of the residual table; NaN (empty statistics) written as "nan".
+std::vector<double> residual_row(const EquilibriumResidual& r) {
+  return {r.frequency_hz,
+          r.coverage,
+          ir_units(r.inscribed_kgm),
+          ir_units(r.in_set.magnitude.min),
+          ir_units(r.in_set.magnitude.median),
+          ir_units(r.in_set.magnitude.mean),
+          ir_units(r.in_set.magnitude.max),
+          ir_units(r.in_set.x.min),
+          ir_units(r.in_set.x.median),
+          ir_units(r.in_set.x.max),
+          r.around_balance_fraction,
+          ir_units(r.around_balance.magnitude.min),
+          ir_units(r.around_balance.magnitude.median),
+          ir_units(r.around_balance.magnitude.max),
+          ir_units(r.around_balance.x.median),
+          ir_units(r.boundary.magnitude.min),
+          ir_units(r.boundary.magnitude.median),
+          ir_units(r.boundary.magnitude.max),
+          ir_units(r.boundary.x.median)};
+}
+
+nlohmann::json stats_json(const ResidualStatistics& s) {
+  if (s.count == 0) return nullptr;
+  return {{"count", s.count}, {"min", ir_units(s.min)}, {"median", ir_units(s.median)}, {"mean", ir_units(s.mean)},
+          {"max", ir_units(s.max)}};
+}
+
+nlohmann::json pair_json(const ResidualPair& p) {
+  return {{"ir", stats_json(p.magnitude)}, {"ir_x", stats_json(p.x)}};
+}
+
 int run_scan(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig& cfg, const Scan& sc, std::size_t n) {
   const EquilibriumScan s = set.scan(sc.from, sc.to, sc.step, n, cfg.other_angles_rad);
+  const std::vector<EquilibriumResidual> res =
+      equilibrium_residual_scan(set, sc.from, sc.to, sc.step, n, cfg.other_angles_rad);
   const auto exact = sc.to > sc.from ? set.exact_band_hz(sc.from, sc.to) : std::nullopt;
-  std::string csv_path, plot_text;
-  PlotStatus ps;
+  const double locked = ir_units(locked_residual_kgm(set));
+  std::string csv_path, plot_text, residual_csv, residual_plot_text;
+  PlotStatus ps, rps;
   if (!a.out.empty()) {
     const fs::path dir = make_out_dir(a.out, "--out");
     csv_path = (dir / "coverage.csv").string();
-    std::ofstream f(csv_path);
-    if (!f) throw ConfigError("--out", dir.string(), "must be writable (" + csv_path + ")");
+    AtomicFile f(csv_path);
     f << "frequency_hz,coverage\n" << std::setprecision(10);
     for (std::size_t k = 0; k < s.frequency_hz.size(); ++k) f << s.frequency_hz[k] << "," << s.coverage[k] << "\n";
-    f.close();
+    f.commit();
     XYLinesPlot plot;
     plot.csv_path = csv_path;
     plot.png_path = (dir / "coverage.png").string();
@@ -220,6 +269,32 @@ int run_scan(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig& c
     plot.series = {{1, 2, "coverage", "linespoints"}};
     ps = Gnuplot().xy_lines(plot);
     plot_text = ps.ran() ? plot.png_path : ps.message;
+
+    residual_csv = (dir / "residual.csv").string();
+    AtomicFile r(residual_csv);
+    r << kResidualHeader << "\n" << std::setprecision(10);
+    for (const auto& e : res) {
+      const auto row = residual_row(e);
+      for (std::size_t c = 0; c < row.size(); ++c) r << (c ? "," : "") << row[c];
+      r << "\n";
+    }
+    r.commit();
+    XYLinesPlot rp;
+    rp.csv_path = residual_csv;
+    rp.png_path = (dir / "residual.png").string();
+    std::ostringstream rt;
+    rt << "residual imbalance the equilibrium set allows (mu = " << set.mu() << ", r_lock = " << std::setprecision(3)
+       << locked << "e-7 kg m)";
+    rp.labels = {rt.str(), "frequency [Hz]", "|I_r| [1e-7 kg m]"};
+    rp.series = {{1, 3, "r_in (closed form: all |I_r| below are in the set)", "lines"},
+                 {1, 5, "median |I_r| over the set", "lines"},
+                 {1, 4, "min |I_r| over the set", "lines"},
+                 {1, 13, "median |I_r|, part around the balancing points", "lines"},
+                 {1, 16, "min |I_r| on the boundary of that part", "linespoints"},
+                 {1, 17, "median |I_r| on the boundary of that part", "linespoints"},
+                 {1, 9, "median I_r,x over the set", "lines"}};
+    rps = Gnuplot().xy_lines(rp);
+    residual_plot_text = rps.ran() ? rp.png_path : rps.message;
   }
   if (a.json) {
     nlohmann::json j;
@@ -228,21 +303,48 @@ int run_scan(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig& c
     j["natural_frequency_hz"] = s.natural_frequency_hz;
     j["band_hz"] = band_json(s.band_hz);
     j["exact_band_hz"] = band_json(exact);
+    j["locked_ir"] = locked;
     nlohmann::json cov = nlohmann::json::array();
-    for (std::size_t k = 0; k < s.frequency_hz.size(); ++k)
-      cov.push_back({{"frequency_hz", s.frequency_hz[k]}, {"coverage", s.coverage[k]}});
+    for (std::size_t k = 0; k < s.frequency_hz.size(); ++k) {
+      const auto& e = res[k];
+      cov.push_back({{"frequency_hz", s.frequency_hz[k]},
+                     {"coverage", s.coverage[k]},
+                     {"inscribed_ir", ir_units(e.inscribed_kgm)},
+                     {"in_set", pair_json(e.in_set)},
+                     {"balance_fraction", e.around_balance_fraction},
+                     {"around_balance", pair_json(e.around_balance)},
+                     {"boundary", pair_json(e.boundary)}});
+    }
     j["coverage"] = cov;
     if (!csv_path.empty()) {
       j["csv"] = csv_path;
       j["plot"] = {{"status", to_string(ps.state)}, {"message", ps.message}, {"script", ps.script_path}};
+      j["residual_csv"] = residual_csv;
+      j["residual_plot"] = {{"status", to_string(rps.state)}, {"message", rps.message}, {"script", rps.script_path}};
     }
     std::cout << j.dump(2) << "\n";
   } else {
     std::cout << std::setprecision(6);
-    std::cout << "# equilibrium-set coverage, mu = " << s.mu << ", " << n << " x " << n << " grid\n";
-    std::cout << "# frequency_hz coverage\n";
-    for (std::size_t k = 0; k < s.frequency_hz.size(); ++k)
-      std::cout << std::setw(12) << s.frequency_hz[k] << " " << s.coverage[k] << "\n";
+    std::cout << "# equilibrium-set coverage and the residual imbalance it allows, mu = " << s.mu << ", " << n << " x "
+              << n << " grid; I_r in 1e-7 kg m\n";
+    std::cout << "# set: grid points in the set; balance: its part around the balancing points; boundary: that "
+                 "part's edge\n";
+    std::cout << "# frequency_hz coverage r_in set_ir_min set_ir_median set_ir_max set_irx_median balance_fraction "
+                 "balance_ir_median boundary_ir_min boundary_ir_median\n";
+    auto col = [](double v) {
+      std::ostringstream os;
+      os << std::setprecision(4) << v;
+      return os.str();
+    };
+    for (std::size_t k = 0; k < s.frequency_hz.size(); ++k) {
+      const auto& e = res[k];
+      std::cout << std::setw(12) << s.frequency_hz[k] << " " << s.coverage[k] << " " << col(ir_units(e.inscribed_kgm))
+                << " " << col(ir_units(e.in_set.magnitude.min)) << " " << col(ir_units(e.in_set.magnitude.median))
+                << " " << col(ir_units(e.in_set.magnitude.max)) << " " << col(ir_units(e.in_set.x.median)) << " "
+                << col(e.around_balance_fraction) << " " << col(ir_units(e.around_balance.magnitude.median)) << " "
+                << col(ir_units(e.boundary.magnitude.min)) << " " << col(ir_units(e.boundary.magnitude.median))
+                << "\n";
+    }
     std::cout << "natural frequency: " << s.natural_frequency_hz << " Hz\n";
     if (s.band_hz)
       std::cout << "band (coverage < 1 on the grid): " << s.band_hz->first << " .. " << s.band_hz->second << " Hz\n";
@@ -250,15 +352,19 @@ int run_scan(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig& c
       std::cout << "band (coverage < 1 on the grid): none in " << sc.from << " .. " << sc.to << " Hz\n";
     if (exact)
       std::cout << "band (closed form, continuous plane): " << exact->first << " .. " << exact->second << " Hz\n";
-    if (!csv_path.empty()) std::cout << "csv: " << csv_path << "\nplot: " << plot_text << "\n";
+    std::cout << "locked residual (in the set at every speed, closed form): |I_r| <= " << locked << "e-7 kg m\n";
+    if (!csv_path.empty())
+      std::cout << "csv: " << csv_path << "\nplot: " << plot_text << "\nresidual csv: " << residual_csv
+                << "\nresidual plot: " << residual_plot_text << "\n";
   }
   return 0;
 }
 
 int run_eqset(const EqsetArgs& a) {
   // Option values first: a bad option is reported before the config is read.
-  if (a.freq && !(std::isfinite(*a.freq) && *a.freq > 0))
-    throw ConfigError("--freq", num_text(*a.freq), "must be a frequency > 0 Hz");
+  if (a.freq && !(std::isfinite(*a.freq) && *a.freq > 0 && *a.freq <= kMaxFrequencyHz))
+    throw ConfigError("--freq", num_text(*a.freq),
+                      "must be a frequency in (0, 1e6] Hz (above it the steady amplitude overflows double precision)");
   if (a.grid && (*a.grid < 2 || *a.grid > kMaxGrid))
     throw ConfigError("--grid", std::to_string(*a.grid), "must be in [2, " + std::to_string(kMaxGrid) + "] (points per axis)");
   if (a.mu && !(std::isfinite(*a.mu) && *a.mu >= 0 && *a.mu < 1))
@@ -303,7 +409,9 @@ void register_eqset(CLI::App& app) {
       "Equilibrium set at constant speed (report fig 4.3): the ball angles (beta_1, beta_2) where all balls\n"
       "can stay stuck, with the steady vibration amplitude there.\n"
       "  --freq HZ: writes DIR/equilibrium_set.csv and .png (set and amplitude contours); prints coverage\n"
-      "  --scan FROM:TO:STEP: prints the coverage per frequency and the band where it is below 1.\n"
+      "  --scan FROM:TO:STEP: prints per frequency the coverage and the residual imbalance the set allows\n"
+      "    (smallest/median/largest |I_r|, I_r,x over the set and around the balancing points), the band\n"
+      "    where the coverage is below 1; with --out also residual.csv/.png.\n"
       "Exit status: 0 ok, 2 bad input.");
   sub->add_option("config", args->config, "YAML config (section abu; optional section eqset)")->required();
   auto* freq = sub->add_option("--freq", args->freq, "constant speed in Hz (> 0)");

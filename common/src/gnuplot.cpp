@@ -1,14 +1,21 @@
 #include "abuopt/common/gnuplot.hpp"
 
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <array>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+
+#include "abuopt/common/output_file.hpp"
 
 namespace abuopt {
 
@@ -36,14 +43,42 @@ std::string resolve(const std::string& exe) {
   return "";
 }
 
-// Single quotes for the shell: 'a'\''b'.
-std::string shell_quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) {
-    if (c == '\'') out += "'\\''";
-    else out += c;
+extern "C" char** environ;
+
+// Runs argv[0] with the argument vector `argv` (no shell: nothing in the arguments is
+// interpreted), in `cwd` when not empty, with stdin from /dev/null and stdout and stderr to
+// `out_fd` (a file or a pipe; -1: /dev/null). Returns the exit status, or -1 with `why` set.
+int spawn_and_wait(const std::vector<std::string>& argv, const std::string& cwd, int out_fd, std::string& why) {
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+  if (out_fd >= 0) {
+    posix_spawn_file_actions_adddup2(&fa, out_fd, 1);
+    posix_spawn_file_actions_adddup2(&fa, out_fd, 2);
+  } else {
+    posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
+    posix_spawn_file_actions_addopen(&fa, 2, "/dev/null", O_WRONLY, 0);
   }
-  return out + "'";
+  if (!cwd.empty()) posix_spawn_file_actions_addchdir_np(&fa, cwd.c_str());
+  std::vector<char*> args;
+  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  pid_t pid = 0;
+  const int rc = ::posix_spawn(&pid, args[0], &fa, nullptr, args.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  if (rc != 0) {
+    why = std::string("cannot start ") + argv[0] + ": " + std::strerror(rc);
+    return -1;
+  }
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) {
+      why = std::string("waitpid: ") + std::strerror(errno);
+      return -1;
+    }
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  why = "gnuplot was ended by signal " + std::to_string(WTERMSIG(status));
+  return -1;
 }
 
 std::string read_text(const std::string& path, std::size_t max_chars) {
@@ -104,12 +139,18 @@ const std::string& Gnuplot::terminal() const {
   terminal_ = "png";
   if (!available()) return terminal_;
   // `set terminal` with no argument lists the terminals this build has (on stderr).
-  const std::string cmd = shell_quote(executable_) + " -e 'set terminal' 2>&1";
-  if (FILE* p = ::popen(cmd.c_str(), "r")) {
-    std::array<char, 4096> buf{};
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC) == 0) {
+    std::string why;
+    // The child gets the write end as stdout/stderr (dup2 clears close-on-exec there; the
+    // originals close at exec). The list is a few kB: it fits the pipe, so waiting first is safe.
+    spawn_and_wait({executable_, "-e", "set terminal"}, "", fds[1], why);
+    ::close(fds[1]);
     std::string out;
-    while (std::size_t got = std::fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), got);
-    ::pclose(p);
+    std::array<char, 4096> buf{};
+    ssize_t got = 0;
+    while ((got = ::read(fds[0], buf.data(), buf.size())) > 0) out.append(buf.data(), static_cast<std::size_t>(got));
+    ::close(fds[0]);
     if (out.find("pngcairo") != std::string::npos) terminal_ = "pngcairo";
   }
   return terminal_;
@@ -119,7 +160,7 @@ std::string Gnuplot::quote(const std::string& text) {
   std::string out = "'";
   for (char c : text) {
     if (c == '\'') out += "''";
-    else if (c == '\n') out += ' ';
+    else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) out += ' ';  // newline, CR, tab, ...: one line
     else out += c;
   }
   return out + "'";
@@ -142,15 +183,7 @@ PlotStatus Gnuplot::run(const std::string& script_body, const std::string& scrip
     << "," << height_px << "\n"
     << "set output " << quote(png_path) << "\n"
     << script_body;
-  {
-    std::ofstream f(script_path);
-    if (!f) {
-      st.state = PlotStatus::State::Failed;
-      st.message = "failed: cannot write the script " + script_path;
-      return st;
-    }
-    f << s.str();
-  }
+  write_file_atomic(script_path, s.str());  // throws OutputError
   if (!available()) {
     st.state = PlotStatus::State::Skipped;
     st.message = "skipped: gnuplot not found (script written to " + script_path + ")";
@@ -159,18 +192,33 @@ PlotStatus Gnuplot::run(const std::string& script_body, const std::string& scrip
   const std::string log_path = (fs::path(script_path).replace_extension(".log")).string();
   std::error_code ec;
   fs::remove(png_path, ec);
-  const std::string cmd = shell_quote(executable_) + " " + shell_quote(script_path) + " > " + shell_quote(log_path) + " 2>&1";
-  const int rc = std::system(cmd.c_str());
+  const int rc = run_script(script_path, "", log_path);
   const bool made = fs::is_regular_file(png_path, ec) && fs::file_size(png_path, ec) > 0;
   if (rc != 0 || !made) {
     st.state = PlotStatus::State::Failed;
-    st.message = "failed: gnuplot " + std::string(rc != 0 ? "exited with status " + std::to_string(rc) : "made no PNG") +
+    st.message = "failed: gnuplot " + std::string(rc == -1 ? "could not be run" : rc != 0 ? "exited with status " + std::to_string(rc) : "made no PNG") +
                  " (" + log_path + "): " + read_text(log_path, 400);
     return st;
   }
   st.state = PlotStatus::State::Ran;
   st.message = "ok";
   return st;
+}
+
+int Gnuplot::run_script(const std::string& script_path, const std::string& working_dir,
+                        const std::string& log_path) const {
+  if (!available()) return -1;
+  const int log = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  std::string why;
+  const int rc = spawn_and_wait({executable_, script_path}, working_dir, log, why);
+  if (log >= 0) {
+    if (!why.empty()) {
+      const std::string line = why + "\n";
+      (void)!::write(log, line.data(), line.size());
+    }
+    ::close(log);
+  }
+  return rc;
 }
 
 std::string Gnuplot::xy_lines_body(const XYLinesPlot& p) {

@@ -6,6 +6,7 @@
 #include <limits>
 #include <ostream>
 #include <sstream>
+#include <stdexcept>
 
 namespace abuopt {
 
@@ -154,6 +155,49 @@ MonteCarloStats compute_statistics(const std::vector<MonteCarloSample>& samples)
   st.settling_max_s = sorted.empty() ? kNaN : sorted.back();
   st.amplitude_mean_mm = mean_of(amplitude);
   st.amplitude_max_mm = amplitude.empty() ? kNaN : *std::max_element(amplitude.begin(), amplitude.end());
+  return st;
+}
+
+double smoothing_bandwidth(const std::vector<double>& values) {
+  const std::size_t n = values.size();
+  if (n < 2) return 0.0;
+  const double m = mean_of(values);
+  double ss = 0;
+  for (double v : values) ss += (v - m) * (v - m);
+  const double sd = std::sqrt(ss / static_cast<double>(n - 1));
+  return 0.9 * sd * std::pow(static_cast<double>(n), -0.2);
+}
+
+SmoothImbalanceStats compute_smooth_statistics(const std::vector<MonteCarloSample>& samples, bool report_x,
+                                               double level) {
+  if (!(level >= 0 && level < 1))
+    throw std::invalid_argument("compute_smooth_statistics: level " + num(level) + " must be in [0, 1)");
+  SmoothImbalanceStats st;
+  st.level = level;
+  std::vector<double> values, ratios;
+  for (const auto& s : samples) {
+    if (!s.outcome.ok()) continue;
+    const double v = report_x ? s.outcome.residual_imbalance_x_kgm : s.outcome.residual_imbalance_kgm;
+    values.push_back(v);
+    ratios.push_back(v / s.imbalance_kgm);
+  }
+  st.count = values.size();
+  if (values.empty()) {
+    st.bandwidth = st.pct_mi = st.quantile = st.cvar = kNaN;
+    return st;
+  }
+  const double n = static_cast<double>(values.size());
+  st.bandwidth = smoothing_bandwidth(ratios);
+  double p = 0;
+  for (double r : ratios)
+    p += st.bandwidth > 0 ? 0.5 * std::erfc(-(r - 1.0) / (st.bandwidth * std::sqrt(2.0))) : (r >= 1.0 ? 1.0 : 0.0);
+  st.pct_mi = 100.0 * p / n;
+  std::vector<double> sorted = values;
+  std::sort(sorted.begin(), sorted.end());
+  st.quantile = quantile_type7(sorted, level);
+  double tail = 0;
+  for (double v : values) tail += std::max(0.0, v - st.quantile);
+  st.cvar = st.quantile + tail / (n * (1.0 - level));
   return st;
 }
 

@@ -81,8 +81,12 @@ void describe_fields(FieldArchive& a, AbuParameters& p) {
   a.field("ball_contact", p.ball_contact, kBallContactNames);
   a.field("ball_restitution", p.ball_restitution, Rule::in_range(0.0, 1.0));
   a.items("balls", p.balls);
-  if (a.mode() == FieldArchive::Mode::Read || a.mode() == FieldArchive::Mode::Validate)
+  if (a.mode() == FieldArchive::Mode::Read || a.mode() == FieldArchive::Mode::Validate) {
+    if (p.balls.size() > 64)  // the same limit as ball_count: run time grows with the square of the count
+      throw ConfigError((a.here().empty() ? "" : a.here() + ".") + "balls", std::to_string(p.balls.size()) + " balls",
+                        "must hold at most 64 balls (as ball_count; the limit is in core/src/simulation_config.cpp)");
     check_balls_fit(p, a.here());
+  }
 }
 
 void describe_fields(FieldArchive& a, InclinedSineSegment& s) {

@@ -1,11 +1,10 @@
 // Comparison of optimisers: runs, solve matrix, data and performance profiles, CSV and gnuplot.
 #include "abuopt/optimizer/benchmarking.hpp"
 
-#include <unistd.h>
-
 #include <algorithm>
+#include <atomic>
 #include <cmath>
-#include <cstdlib>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -13,8 +12,12 @@
 #include <random>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/common/gnuplot.hpp"
+#include "abuopt/common/output_file.hpp"
+#include "abuopt/common/text.hpp"
 #include "abuopt/optimizer/algorithms.hpp"
 #include "abuopt/optimizer/minimize.hpp"
 
@@ -32,18 +35,8 @@ double true_objective(const EvaluationRecord& r, const std::string& metric) {
 
 double solved_threshold(double f_star, double tau) { return tau * std::max(std::fabs(f_star), 1.0); }
 
-std::string csv_number(double v) {
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  if (std::isnan(v)) return "nan";
-  return format_number(v);
-}
-
-std::string csv_text(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
-}
+using abuopt::csv_number;
+std::string csv_text(const std::string& s) { return abuopt::csv_field(s); }
 
 std::string file_safe(const std::string& s) {
   std::string out = s;
@@ -194,14 +187,21 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
     std::unique_ptr<Problem> probe = spec.make();
     const auto starts = starting_points(*probe, spec.starts, spec.seed);
     const std::size_t first_run = out.runs.size();
-    for (int k = 0; k < spec.starts; ++k) {
-      for (const SolverSpec& solver : setup.solvers) {
+    // the runs of this problem are independent: each has its own problem instance, start and seed,
+    // and lands in its own slot, so the results do not depend on how many run at once
+    const std::size_t tasks = static_cast<std::size_t>(spec.starts) * setup.solvers.size();
+    out.runs.resize(first_run + tasks);
+    auto run_task = [&](std::size_t t) {
+      const int k = static_cast<int>(t / setup.solvers.size());
+      const SolverSpec& solver = setup.solvers[t % setup.solvers.size()];
+      {
         std::unique_ptr<Problem> problem = spec.make();
         OptimizerOptions o = solver.options;
         o.max_evaluations = spec.max_evaluations;
         o.constraint_tolerance = spec.constraint_tolerance;
         o.seed = spec.seed + static_cast<unsigned long>(k);
         o.keep_history = true;
+        o.handle_sigint = o.handle_sigint && setup.threads <= 1;  // one handler owner at a time
         RunRecord rec;
         rec.problem = spec.label;
         rec.solver = solver.label;
@@ -228,8 +228,28 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
         }
         rec.best_true_objective = best;
         rec.feasible = std::isfinite(best);
-        out.runs.push_back(std::move(rec));
+        out.runs[first_run + t] = std::move(rec);
       }
+    };
+    const std::size_t workers = std::min<std::size_t>(std::max(1, setup.threads), tasks);
+    if (workers <= 1) {
+      for (std::size_t t = 0; t < tasks; ++t) run_task(t);
+    } else {
+      std::atomic<std::size_t> next{0};
+      std::vector<std::exception_ptr> errors(workers);
+      std::vector<std::thread> pool;
+      for (std::size_t w = 0; w < workers; ++w)
+        pool.emplace_back([&, w] {
+          try {
+            for (std::size_t t = next++; t < tasks; t = next++) run_task(t);
+          } catch (...) {
+            errors[w] = std::current_exception();  // rethrown below, as a serial run would
+            next = tasks;
+          }
+        });
+      for (std::thread& th : pool) th.join();
+      for (const std::exception_ptr& e : errors)
+        if (e) std::rethrow_exception(e);
     }
     // the reference value f*
     double f_star = kInf;
@@ -303,28 +323,29 @@ std::string format_table(const ComparisonResult& r) {
   return os.str();
 }
 
-std::string find_gnuplot() {
-  if (const char* path = std::getenv("PATH")) {
-    std::stringstream ss(path);
-    std::string dir;
-    while (std::getline(ss, dir, ':')) {
-      if (dir.empty()) continue;
-      const std::string candidate = dir + "/gnuplot";
-      if (access(candidate.c_str(), X_OK) == 0) return candidate;
-    }
-  }
-  if (access("/usr/bin/gnuplot", X_OK) == 0) return "/usr/bin/gnuplot";
-  return "";
-}
+std::string find_gnuplot() { return Gnuplot::find(); }
 
 namespace {
 
-std::ofstream open_out(const std::filesystem::path& path, WrittenFiles& written) {
-  std::ofstream f(path);
-  if (!f) throw ConfigError("output file '" + path.string() + "' cannot be written");
-  written.files.push_back(path.string());
-  return f;
-}
+// A result file: collected, then written whole under its name by commit() (OutputError when the
+// write fails: nothing half-written is left under the final name).
+class OutFile {
+ public:
+  OutFile(const std::filesystem::path& path, WrittenFiles& written) : file_(path), written_(written) {}
+  template <class T>
+  OutFile& operator<<(const T& v) {
+    file_.stream() << v;
+    return *this;
+  }
+  void commit() {
+    file_.commit();
+    written_.files.push_back(file_.path().string());
+  }
+
+ private:
+  AtomicFile file_;
+  WrittenFiles& written_;
+};
 
 // Abscissae of the profiles: alpha in [0, max budget / (n_p + 1)], tau in [1, max finite ratio].
 std::vector<double> alpha_grid(const ComparisonResult& r) {
@@ -359,7 +380,7 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
   const fs::path dir(directory);
 
   {
-    auto f = open_out(dir / "runs.csv", written);
+    OutFile f(dir / "runs.csv", written);
     f << "problem,start,solver,algorithm,dimension,x0,reason,best_true_objective,feasible,objective,max_violation,"
          "evaluations,evaluations_to_tau,f_star,wall_time_s,message\n";
     for (const RunRecord& run : r.runs) {
@@ -374,9 +395,10 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
         << run.result.evaluations << "," << run.evaluations_to_solve << "," << csv_number(r.f_star[p]) << ","
         << csv_number(run.result.wall_time_s) << "," << csv_text(run.result.message) << "\n";
     }
+    f.commit();
   }
   {
-    auto f = open_out(dir / "convergence.csv", written);
+    OutFile f(dir / "convergence.csv", written);
     f << "problem,start,solver,evaluation,best_feasible_true_objective,relative_gap\n";
     for (const RunRecord& run : r.runs) {
       const std::size_t p = static_cast<std::size_t>(
@@ -387,11 +409,12 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
           << csv_number(c.best) << "," << csv_number(gap) << "\n";
       }
     }
+    f.commit();
   }
   const auto t = r.solve_matrix();
   const auto dims = r.instance_dimensions();
   {
-    auto f = open_out(dir / "data_profile.csv", written);
+    OutFile f(dir / "data_profile.csv", written);
     const auto alphas = alpha_grid(r);
     std::vector<std::vector<double>> d;
     for (std::size_t s = 0; s < r.solvers.size(); ++s) d.push_back(data_profile(t, dims, s, alphas));
@@ -403,9 +426,10 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
       for (std::size_t s = 0; s < r.solvers.size(); ++s) f << "," << format_number(d[s][i]);
       f << "\n";
     }
+    f.commit();
   }
   {
-    auto f = open_out(dir / "performance_profile.csv", written);
+    OutFile f(dir / "performance_profile.csv", written);
     const auto taus = tau_grid(t);
     std::vector<std::vector<double>> rho;
     for (std::size_t s = 0; s < r.solvers.size(); ++s) rho.push_back(performance_profile(t, s, taus));
@@ -417,34 +441,59 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
       for (std::size_t s = 0; s < r.solvers.size(); ++s) f << "," << format_number(rho[s][i]);
       f << "\n";
     }
+    f.commit();
   }
 
-  // convergence curves of start 0, one data block per solver, per problem
+  // Convergence curves of start 0: one data block per solver that has a curve, per problem. A
+  // solver without a feasible point has no block (gnuplot's `index` counts the blocks that are
+  // there, so an empty block would shift every later curve onto the wrong name); it is named in
+  // the key instead. A gap of 0 (f* reached) cannot be drawn on the log axis: the curve ends at
+  // its last positive value and the key says where f* was reached.
+  struct Curve {
+    std::string solver;
+    long index = -1;            // data block; -1: no feasible point
+    long reached_at = -1;       // evaluation at which the gap became <= 0; -1: never
+  };
   std::vector<std::string> pngs = {"data_profile.png", "performance_profile.png"};
   std::vector<std::string> conv_files;
+  std::vector<std::vector<Curve>> curves(r.problems.size());
   for (std::size_t p = 0; p < r.problems.size(); ++p) {
     const std::string name = "convergence_" + file_safe(r.problems[p]) + ".dat";
-    auto f = open_out(dir / name, written);
+    OutFile f(dir / name, written);
+    long blocks = 0;
     for (const std::string& solver : r.solvers) {
-      f << "# " << solver << "\n";
+      Curve curve;
+      curve.solver = solver;
+      std::ostringstream block;
       for (const RunRecord& run : r.runs) {
         if (run.problem != r.problems[p] || run.solver != solver || run.start != 0) continue;
         const double scale = std::max(std::fabs(r.f_star[p]), 1.0);
         for (std::size_t i = 0; i < run.convergence.size(); ++i) {
-          const double gap = std::max((run.convergence[i].best - r.f_star[p]) / scale, 1e-12);
-          f << run.convergence[i].evaluation << " " << format_number(gap) << "\n";
+          const double gap = (run.convergence[i].best - r.f_star[p]) / scale;
+          if (!(gap > 0)) {
+            if (curve.reached_at < 0) curve.reached_at = run.convergence[i].evaluation;
+            continue;
+          }
+          block << run.convergence[i].evaluation << " " << format_number(gap) << "\n";
           const long next = i + 1 < run.convergence.size() ? run.convergence[i + 1].evaluation : run.result.evaluations;
-          if (next > run.convergence[i].evaluation) f << next << " " << format_number(gap) << "\n";  // staircase
+          if (next > run.convergence[i].evaluation) block << next << " " << format_number(gap) << "\n";  // staircase
         }
       }
-      f << "\n\n";
+      if (!block.str().empty()) {
+        f << "# " << solver << "\n" << block.str() << "\n\n";
+        curve.index = blocks++;
+      }
+      curves[p].push_back(curve);
     }
     conv_files.push_back(name);
     pngs.push_back("convergence_" + file_safe(r.problems[p]) + ".png");
+    f.commit();
   }
 
   {
-    auto f = open_out(dir / "plots.gp", written);
+    // Every text from the setup (solver and problem labels) goes through Gnuplot::quote: a label
+    // cannot end the string and add a command.
+    OutFile f(dir / "plots.gp", written);
     const std::size_t ns = r.solvers.size();
     f << "# gnuplot script written by abuopt compare; run: gnuplot plots.gp (in this directory)\n"
       << "set datafile separator ','\nset terminal pngcairo size 900,600 noenhanced\nset key bottom right\n"
@@ -453,34 +502,49 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
       << "): fraction of problems solved within alpha (n_p+1) evaluations'\n"
       << "set xlabel 'alpha = evaluations / (n_p + 1)'\nset ylabel 'd_s(alpha)'\nplot ";
     for (std::size_t s = 0; s < ns; ++s)
-      f << (s ? ", " : "") << "'data_profile.csv' using 1:" << s + 2 << " with steps lw 2 title '" << r.solvers[s]
-        << "'";
+      f << (s ? ", " : "") << "'data_profile.csv' using 1:" << s + 2 << " with steps lw 2 title "
+        << Gnuplot::quote(r.solvers[s]);
     f << "\nset output 'performance_profile.png'\nset title 'Performance profile (tau = " << format_number(r.tau)
       << "): evaluations relative to the best solver'\nset logscale x 2\n"
       << "set xlabel 'ratio to the best solver'\nset ylabel 'rho_s(ratio)'\nplot ";
     for (std::size_t s = 0; s < ns; ++s)
-      f << (s ? ", " : "") << "'performance_profile.csv' using 1:" << s + 2 << " with steps lw 2 title '"
-        << r.solvers[s] << "'";
+      f << (s ? ", " : "") << "'performance_profile.csv' using 1:" << s + 2 << " with steps lw 2 title "
+        << Gnuplot::quote(r.solvers[s]);
     f << "\nunset logscale x\nset datafile separator whitespace\nset autoscale y\nset logscale y\nset key top right\n"
       << "set format y '%.0e'\n";
     for (std::size_t p = 0; p < r.problems.size(); ++p) {
-      f << "set output '" << pngs[2 + p] << "'\nset title 'Convergence on " << r.problems[p]
-        << " (first start): best feasible (f - f*) / max(|f*|, 1)'\nset xlabel 'evaluations'\n"
+      f << "set output " << Gnuplot::quote(pngs[2 + p]) << "\nset title "
+        << Gnuplot::quote("Convergence on " + r.problems[p] + " (first start): best feasible (f - f*) / max(|f*|, 1)")
+        << "\nset xlabel 'evaluations'\n"
         << "set ylabel 'relative gap'\nplot ";
-      for (std::size_t s = 0; s < ns; ++s)
-        f << (s ? ", " : "") << "'" << conv_files[p] << "' index " << s << " using 1:2 with lines lw 2 title '"
-          << r.solvers[s] << "'";
+      for (std::size_t s = 0; s < curves[p].size(); ++s) {
+        const Curve& c = curves[p][s];
+        f << (s ? ", " : "");
+        const std::string title =
+            c.solver + (c.reached_at < 0 ? "" : " (reaches f* at evaluation " + std::to_string(c.reached_at) + ")");
+        if (c.index < 0) {  // nothing to draw: no feasible point, or a gap of 0 from the first one
+          f << "NaN with lines lw 2 title " << Gnuplot::quote(c.reached_at < 0 ? c.solver + " (no feasible point)" : title);
+          continue;
+        }
+        f << Gnuplot::quote(conv_files[p]) << " index " << c.index << " using 1:2 with lines lw 2 title "
+          << Gnuplot::quote(title);
+      }
       f << "\n";
     }
     f << "unset output\n";
+    f.commit();
   }
 
-  written.gnuplot = make_plots ? find_gnuplot() : "";
+  const Gnuplot gp;
+  written.gnuplot = make_plots ? gp.executable() : "";
   if (written.gnuplot.empty()) {
     written.skipped_plots = pngs;
   } else {
-    const std::string cmd = "cd '" + fs::absolute(dir).string() + "' && '" + written.gnuplot + "' plots.gp 2>gnuplot.log";
-    const int rc = std::system(cmd.c_str());
+    // No shell: gnuplot runs with an argument vector, in the output directory.
+    std::error_code ec;
+    for (const std::string& png : pngs) fs::remove(dir / png, ec);
+    const fs::path abs = fs::absolute(dir);
+    const int rc = gp.run_script("plots.gp", abs.string(), (abs / "gnuplot.log").string());
     for (const std::string& png : pngs) {
       if (rc == 0 && fs::exists(dir / png) && fs::file_size(dir / png) > 0) written.files.push_back((dir / png).string());
       else written.skipped_plots.push_back(png);

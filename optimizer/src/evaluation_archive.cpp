@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstring>
 #include <ctime>
+#include <iostream>
 #include <stdexcept>
 
 #include <nlohmann/json.hpp>
@@ -63,6 +64,47 @@ json vector_json(const std::vector<double>& v) {
   return a;
 }
 
+constexpr int kSchemaVersion = 2;
+
+// FNV-1a, 64 bits, as 16 hex digits: any single changed byte changes it (each step is a bijection
+// of the state for a given byte, and distinct bytes give distinct states).
+std::string fnv1a64_hex(const std::string& text) {
+  std::uint64_t h = 14695981039346656037ULL;
+  for (unsigned char c : text) {
+    h ^= c;
+    h *= 1099511628211ULL;
+  }
+  char out[17];
+  std::snprintf(out, sizeof out, "%016llx", static_cast<unsigned long long>(h));
+  return out;
+}
+
+// The checksum of a row: every field that is read back, separated by a byte no field contains.
+std::string row_checksum(const std::string& problem_id, const std::string& x_key, long runs,
+                         const std::string& values_hex, long n_inequality, const std::string& metrics, long ok,
+                         const std::string& message) {
+  const char sep = '\x1f';
+  std::string text = problem_id;
+  text += sep;
+  text += x_key;
+  text += sep;
+  text += std::to_string(runs);
+  text += sep;
+  text += values_hex;
+  text += sep;
+  text += std::to_string(n_inequality);
+  text += sep;
+  text += metrics;
+  text += sep;
+  text += std::to_string(ok);
+  text += sep;
+  text += message;
+  return fnv1a64_hex(text);
+}
+
+// SQLite's own verdict on a damaged file (as opposed to a busy or full one).
+bool is_corruption(int rc) { return (rc & 0xff) == SQLITE_CORRUPT || (rc & 0xff) == SQLITE_NOTADB; }
+
 std::string now_utc() {
   const auto now = std::chrono::system_clock::now();
   const std::time_t t = std::chrono::system_clock::to_time_t(now);
@@ -80,9 +122,9 @@ std::string now_utc() {
 // RAII prepared statement.
 class Statement {
  public:
-  Statement(sqlite3* db, const char* sql) : db_(db) {
-    if (sqlite3_prepare_v2(db, sql, -1, &stmt_, nullptr) != SQLITE_OK)
-      throw std::runtime_error(std::string("evaluation archive: ") + sqlite3_errmsg(db));
+  Statement(sqlite3* db, const std::string& path, const char* sql) : db_(db), path_(path) {
+    const int rc = sqlite3_prepare_v2(db, sql, -1, &stmt_, nullptr);
+    if (rc != SQLITE_OK) fail(rc);
   }
   ~Statement() { sqlite3_finalize(stmt_); }
   Statement(const Statement&) = delete;
@@ -93,11 +135,20 @@ class Statement {
     else sqlite3_bind_double(stmt_, i, d);
   }
   void bind_int(int i, long v) { sqlite3_bind_int64(stmt_, i, v); }
+  void reset() { sqlite3_reset(stmt_); }
   bool step() {
     const int rc = sqlite3_step(stmt_);
     if (rc == SQLITE_ROW) return true;
     if (rc == SQLITE_DONE) return false;
-    throw std::runtime_error(std::string("evaluation archive: ") + sqlite3_errmsg(db_));
+    fail(rc);
+  }
+  // A damaged file is the user's to repair (ConfigError); anything else is an I/O failure.
+  [[noreturn]] void fail(int rc) const {
+    const std::string why = sqlite3_errmsg(db_);
+    if (is_corruption(rc))
+      throw ConfigError("evaluation archive '" + path_ + "' is damaged (" + why +
+                        "): move it away or delete it (its evaluations are recomputed)");
+    throw std::runtime_error("evaluation archive '" + path_ + "': " + why);
   }
   std::string text(int col) const {
     const unsigned char* t = sqlite3_column_text(stmt_, col);
@@ -108,8 +159,15 @@ class Statement {
 
  private:
   sqlite3* db_;
+  std::string path_;
   sqlite3_stmt* stmt_ = nullptr;
 };
+
+// Columns from `first`: values_hex, ok, message, metrics, n_inequality, checksum (then the caller's
+// problem id, x_key and runs complete the checksum). nullopt: the row fails its checksum or does
+// not parse (damaged).
+std::optional<Evaluation> intact_evaluation_of(const Statement& s, int first, const std::string& problem_id,
+                                               const std::string& x_key, long runs);
 
 // Columns: values_hex, ok, message, metrics, n_inequality
 Evaluation evaluation_of(const Statement& s, int first) {
@@ -127,6 +185,18 @@ Evaluation evaluation_of(const Statement& s, int first) {
   return e;
 }
 
+std::optional<Evaluation> intact_evaluation_of(const Statement& s, int first, const std::string& problem_id,
+                                               const std::string& x_key, long runs) {
+  const std::string expected = row_checksum(problem_id, x_key, runs, s.text(first), s.integer(first + 4),
+                                            s.text(first + 3), s.integer(first + 1), s.text(first + 2));
+  if (expected != s.text(first + 5)) return std::nullopt;
+  try {
+    return evaluation_of(s, first);
+  } catch (const std::exception&) {  // right checksum, unreadable content: damaged all the same
+    return std::nullopt;
+  }
+}
+
 }  // namespace
 
 std::string EvaluationArchive::key_of(const std::vector<double>& x) { return hex_of(x); }
@@ -142,6 +212,30 @@ EvaluationArchive::EvaluationArchive(const std::string& path, std::string proble
   }
   sqlite3_busy_timeout(db_, 10000);
   try {
+    // SQLite's own check of the file (pages, indexes): garbage in it ends here, naming the file
+    {
+      Statement check(db_, path_, "PRAGMA quick_check");
+      const std::string verdict = check.step() ? check.text(0) : "no answer";
+      if (verdict != "ok")
+        throw ConfigError("evaluation archive '" + path_ + "' is damaged (" + verdict +
+                          "): move it away or delete it (its evaluations are recomputed)");
+    }
+    long found = 0;
+    bool existing = false;
+    {  // (statements end before the journal mode changes: no open read transaction)
+      Statement version(db_, path_, "PRAGMA user_version");
+      version.step();
+      found = version.integer(0);
+      Statement tables(db_, path_,
+                       "SELECT COUNT(*) FROM sqlite_master WHERE type = 'table' AND name = 'evaluations'");
+      tables.step();
+      existing = tables.integer(0) > 0;
+    }
+    if (existing && found != kSchemaVersion)
+      throw ConfigError("evaluation archive '" + path_ + "' has schema version " + std::to_string(found) +
+                        "; this abuopt reads version " + std::to_string(kSchemaVersion) +
+                        " (checksums and run counts per evaluation): move it away or delete it (its evaluations "
+                        "are recomputed)");
     exec("PRAGMA journal_mode=WAL");
     exec("PRAGMA synchronous=NORMAL");
     exec(
@@ -149,6 +243,7 @@ EvaluationArchive::EvaluationArchive(const std::string& path, std::string proble
         " id INTEGER PRIMARY KEY AUTOINCREMENT,"
         " problem_id TEXT NOT NULL,"
         " x_key TEXT NOT NULL,"        // hex of the bits of x (exact)
+        " runs INTEGER NOT NULL,"      // Monte Carlo runs of the value (0: not a sampled problem)
         " x TEXT NOT NULL,"            // JSON array (readable)
         " objective REAL,"             // readable; NULL for NaN
         " values_hex TEXT NOT NULL,"   // hex of objective, g..., h... (exact)
@@ -160,16 +255,40 @@ EvaluationArchive::EvaluationArchive(const std::string& path, std::string proble
         " message TEXT NOT NULL,"
         " wall_time_s REAL,"
         " timestamp TEXT NOT NULL,"
-        " UNIQUE(problem_id, x_key))");
+        " checksum TEXT NOT NULL,"     // row_checksum() of the fields read back
+        " UNIQUE(problem_id, x_key, runs))");
     exec(
         "CREATE TABLE IF NOT EXISTS problems ("
         " problem_id TEXT PRIMARY KEY, name TEXT, variables TEXT, inequality TEXT, equality TEXT,"
         " created TEXT)");
+    if (!existing) exec(("PRAGMA user_version = " + std::to_string(kSchemaVersion)).c_str());
+  } catch (const ConfigError&) {
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw;
   } catch (const std::exception& e) {
     sqlite3_close(db_);
     db_ = nullptr;
     throw ConfigError("evaluation archive '" + path + "' is not usable: " + e.what());
   }
+  warn_ = [](const std::string& w) { std::cerr << "warning: " << w << "\n"; };
+}
+
+int EvaluationArchive::schema_version() { return kSchemaVersion; }
+
+void EvaluationArchive::set_warning_handler(std::function<void(const std::string&)> handler) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  warn_ = std::move(handler);
+}
+
+void EvaluationArchive::discard_damaged(long id, const std::string& what) const {
+  Statement d(db_, path_, "DELETE FROM evaluations WHERE id = ?1");
+  d.bind_int(1, id);
+  d.step();
+  ++damaged_;
+  if (warn_)
+    warn_("evaluation archive '" + path_ + "': stored evaluation #" + std::to_string(id) +
+          " fails its checksum (damaged): " + what);
 }
 
 EvaluationArchive::~EvaluationArchive() {
@@ -178,56 +297,72 @@ EvaluationArchive::~EvaluationArchive() {
 
 void EvaluationArchive::exec(const char* sql) const {
   char* err = nullptr;
-  if (sqlite3_exec(db_, sql, nullptr, nullptr, &err) != SQLITE_OK) {
+  const int rc = sqlite3_exec(db_, sql, nullptr, nullptr, &err);
+  if (rc != SQLITE_OK) {
     const std::string why = err ? err : "unknown error";
     sqlite3_free(err);
-    throw std::runtime_error("evaluation archive: " + why);
+    if (is_corruption(rc))
+      throw ConfigError("evaluation archive '" + path_ + "' is damaged (" + why +
+                        "): move it away or delete it (its evaluations are recomputed)");
+    throw std::runtime_error("evaluation archive '" + path_ + "': " + why);
   }
 }
 
-std::optional<Evaluation> EvaluationArchive::find(const std::vector<double>& x) const {
+std::optional<Evaluation> EvaluationArchive::find(const std::vector<double>& x, long runs) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  Statement s(db_,
-              "SELECT values_hex, ok, message, metrics, n_inequality FROM evaluations"
-              " WHERE problem_id = ?1 AND x_key = ?2");
+  const std::string key = hex_of(x);
+  Statement s(db_, path_,
+              "SELECT values_hex, ok, message, metrics, n_inequality, checksum, id FROM evaluations"
+              " WHERE problem_id = ?1 AND x_key = ?2 AND runs = ?3");
   s.bind(1, problem_id_);
-  s.bind(2, hex_of(x));
+  s.bind(2, key);
+  s.bind_int(3, runs);
   if (!s.step()) return std::nullopt;
-  Evaluation e = evaluation_of(s, 0);
-  e.from_archive = true;
+  std::optional<Evaluation> e = intact_evaluation_of(s, 0, problem_id_, key, runs);
+  if (!e) {
+    const long id = s.integer(6);
+    s.reset();
+    discard_damaged(id, "recomputed");
+    return std::nullopt;
+  }
+  e->from_archive = true;
   return e;
 }
 
-void EvaluationArchive::store(const std::vector<double>& x, const Evaluation& e, double wall_time_s) {
+void EvaluationArchive::store(const std::vector<double>& x, const Evaluation& e, double wall_time_s, long runs) {
   std::vector<double> values{e.objective};
   values.insert(values.end(), e.inequality.begin(), e.inequality.end());
   values.insert(values.end(), e.equality.begin(), e.equality.end());
   json metrics = json::object();
   for (const auto& [k, v] : e.metrics) metrics[k] = number_json(v);
+  const std::string key = hex_of(x), values_hex = hex_of(values), metrics_text = metrics.dump();
+  const long n_inequality = static_cast<long>(e.inequality.size()), ok = e.ok ? 1 : 0;
   std::lock_guard<std::mutex> lock(mutex_);
-  Statement s(db_,
-              "INSERT OR IGNORE INTO evaluations (problem_id, x_key, x, objective, values_hex, n_inequality,"
-              " inequality, equality, metrics, ok, message, wall_time_s, timestamp)"
-              " VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13)");
+  Statement s(db_, path_,
+              "INSERT OR IGNORE INTO evaluations (problem_id, x_key, runs, x, objective, values_hex, n_inequality,"
+              " inequality, equality, metrics, ok, message, wall_time_s, timestamp, checksum)"
+              " VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15)");
   s.bind(1, problem_id_);
-  s.bind(2, hex_of(x));
-  s.bind(3, vector_json(x).dump());
-  s.bind(4, e.objective);
-  s.bind(5, hex_of(values));
-  s.bind_int(6, static_cast<long>(e.inequality.size()));
-  s.bind(7, vector_json(e.inequality).dump());
-  s.bind(8, vector_json(e.equality).dump());
-  s.bind(9, metrics.dump());
-  s.bind_int(10, e.ok ? 1 : 0);
-  s.bind(11, e.message);
-  s.bind(12, wall_time_s);
-  s.bind(13, now_utc());
+  s.bind(2, key);
+  s.bind_int(3, runs);
+  s.bind(4, vector_json(x).dump());
+  s.bind(5, e.objective);
+  s.bind(6, values_hex);
+  s.bind_int(7, n_inequality);
+  s.bind(8, vector_json(e.inequality).dump());
+  s.bind(9, vector_json(e.equality).dump());
+  s.bind(10, metrics_text);
+  s.bind_int(11, ok);
+  s.bind(12, e.message);
+  s.bind(13, wall_time_s);
+  s.bind(14, now_utc());
+  s.bind(15, row_checksum(problem_id_, key, runs, values_hex, n_inequality, metrics_text, ok, e.message));
   s.step();  // autocommit: one transaction per store
 }
 
 long EvaluationArchive::count() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  Statement s(db_, "SELECT COUNT(*) FROM evaluations WHERE problem_id = ?1");
+  Statement s(db_, path_, "SELECT COUNT(*) FROM evaluations WHERE problem_id = ?1");
   s.bind(1, problem_id_);
   s.step();
   return s.integer(0);
@@ -235,21 +370,37 @@ long EvaluationArchive::count() const {
 
 std::vector<EvaluationArchive::Entry> EvaluationArchive::entries() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  Statement s(db_,
-              "SELECT id, x_key, wall_time_s, timestamp, values_hex, ok, message, metrics, n_inequality"
-              " FROM evaluations WHERE problem_id = ?1 ORDER BY id");
+  Statement s(db_, path_,
+              "SELECT id, x_key, wall_time_s, timestamp, values_hex, ok, message, metrics, n_inequality, checksum,"
+              " runs FROM evaluations WHERE problem_id = ?1 ORDER BY id");
   s.bind(1, problem_id_);
   std::vector<Entry> out;
+  std::vector<long> damaged;
   while (s.step()) {
     Entry en;
     en.id = s.integer(0);
-    en.x = doubles_of_hex(s.text(1));
+    en.runs = s.integer(10);
+    const std::string key = s.text(1);
+    std::optional<Evaluation> e = intact_evaluation_of(s, 4, problem_id_, key, en.runs);
+    if (e) {
+      try {
+        en.x = doubles_of_hex(key);
+      } catch (const std::exception&) {
+        e.reset();
+      }
+    }
+    if (!e) {
+      damaged.push_back(en.id);
+      continue;
+    }
     en.wall_time_s = s.real(2);
     en.timestamp = s.text(3);
-    en.evaluation = evaluation_of(s, 4);
+    en.evaluation = std::move(*e);
     en.evaluation.from_archive = true;
     out.push_back(std::move(en));
   }
+  s.reset();
+  for (long id : damaged) discard_damaged(id, "left out");
   return out;
 }
 
@@ -260,7 +411,7 @@ void EvaluationArchive::check_signature(const Problem& problem) {
   const std::string ineq = json(problem.inequality_names()).dump();
   const std::string eq = json(problem.equality_names()).dump();
   std::lock_guard<std::mutex> lock(mutex_);
-  Statement q(db_, "SELECT variables, inequality, equality FROM problems WHERE problem_id = ?1");
+  Statement q(db_, path_, "SELECT variables, inequality, equality FROM problems WHERE problem_id = ?1");
   q.bind(1, problem_id_);
   if (q.step()) {
     auto differ = [&](const char* what, const std::string& stored, const std::string& now) {
@@ -274,7 +425,7 @@ void EvaluationArchive::check_signature(const Problem& problem) {
     differ("equality constraints", q.text(2), eq);
     return;
   }
-  Statement s(db_,
+  Statement s(db_, path_,
               "INSERT INTO problems (problem_id, name, variables, inequality, equality, created)"
               " VALUES (?1, ?2, ?3, ?4, ?5, ?6)");
   s.bind(1, problem_id_);

@@ -58,7 +58,14 @@ void check_value(const DesignValue& v, const std::string& path, bool duration) {
 }  // namespace
 
 const EnumNames<ObjectiveKind> kObjectiveKindNames = {
-    {ObjectiveKind::Mean, "mean"}, {ObjectiveKind::PctMi, "pct_mi"}, {ObjectiveKind::Weighted, "weighted"}};
+    {ObjectiveKind::Mean, "mean"},
+    {ObjectiveKind::PctMi, "pct_mi"},
+    {ObjectiveKind::Weighted, "weighted"},
+    {ObjectiveKind::SmoothPctMi, "smooth_pct_mi"},
+    {ObjectiveKind::Quantile, "quantile"},
+    {ObjectiveKind::Cvar, "cvar"}};
+const EnumNames<PctMiStatistic> kPctMiStatisticNames = {{PctMiStatistic::Exact, "exact"},
+                                                        {PctMiStatistic::Smooth, "smooth"}};
 const EnumNames<ImbalanceDefinition> kImbalanceDefinitionNames = {{ImbalanceDefinition::Magnitude, "magnitude"},
                                                                   {ImbalanceDefinition::ReportX, "report_x"}};
 const EnumNames<AmplitudeStatistic> kAmplitudeStatisticNames = {{AmplitudeStatistic::Max, "max"},
@@ -67,6 +74,15 @@ const EnumNames<AmplitudeStatistic> kAmplitudeStatisticNames = {{AmplitudeStatis
 std::string to_string(ObjectiveKind k) { return enum_name(kObjectiveKindNames, k); }
 std::string to_string(ImbalanceDefinition d) { return enum_name(kImbalanceDefinitionNames, d); }
 std::string to_string(AmplitudeStatistic a) { return enum_name(kAmplitudeStatisticNames, a); }
+
+double peak_angular_acceleration_rad_s2(const StartupProfile& profile) {
+  double peak = 0, f0 = profile.start_frequency_hz();
+  for (const auto& g : profile.segments()) {
+    peak = std::max(peak, 2 * M_PI * 2 * std::abs(g.end_frequency_hz - f0) / g.duration_s);
+    f0 = g.end_frequency_hz;
+  }
+  return peak;
+}
 
 std::uint64_t fnv1a64(std::string_view text) {
   std::uint64_t h = 14695981039346656037ull;
@@ -117,7 +133,11 @@ void describe_design_fields(FieldArchive& a, ProfileDesign& d, const StartupProf
   };
   a.list("segments", d.segments.size(), fill,
          [&](std::size_t i) {
-           describe_design_value(a, "end_frequency_hz", d.segments[i].end_frequency_hz, i);
+           // hold: true replaces end_frequency_hz (a dwell at the previous end frequency).
+           FieldOptions hold = FieldOptions::only_if(true, "");
+           hold.enabled = a.reading() || d.segments[i].hold;
+           a.field("hold", d.segments[i].hold, hold);
+           if (!d.segments[i].hold) describe_design_value(a, "end_frequency_hz", d.segments[i].end_frequency_hz, i);
            describe_design_value(a, "duration_s", d.segments[i].duration_s, i);
          },
          FieldOptions::required_key("(one entry per profile segment: {end_frequency_hz, duration_s})"));
@@ -127,6 +147,9 @@ void describe_design_fields(FieldArchive& a, ProfileDesign& d, const StartupProf
 void describe_fields(FieldArchive& a, ObjectiveSettings& o) {
   a.field("kind", o.kind, kObjectiveKindNames);
   a.field("definition", o.definition, kImbalanceDefinitionNames);
+  a.field("level", o.level, Rule::in_range(1e-9, 0.999999),
+          FieldOptions::only_if(o.kind == ObjectiveKind::Quantile || o.kind == ObjectiveKind::Cvar,
+                                "is only used with objective.kind: quantile or cvar"));
   const bool weighted = o.kind == ObjectiveKind::Weighted;
   if (a.reading() && weighted && !a.has("weights"))
     throw ConfigError(a.path("weights"), "<missing>", "is required with objective.kind: weighted ({mean: w1, pct_mi: w2})");
@@ -146,8 +169,12 @@ void describe_fields(FieldArchive& a, ConstraintSettings& c) {
   a.field("max_startup_time_s", c.max_startup_time_s, Rule::positive());
   a.field("max_amplitude_mm", c.max_amplitude_mm, Rule::positive());
   a.field("max_pct_mi", c.max_pct_mi, Rule::in_range(1e-9, 100.0));
+  a.field("max_angular_acceleration_rad_s2", c.max_angular_acceleration_rad_s2, Rule::positive());
   a.field("amplitude", c.amplitude, kAmplitudeStatisticNames);
   a.field("penalty_weight", c.penalty_weight, Rule::non_negative());
+  FieldOptions statistic;  // written (and in the identity) only when not the default exact count
+  statistic.enabled = a.reading() || c.pct_mi_statistic != PctMiStatistic::Exact;
+  a.field("pct_mi_statistic", c.pct_mi_statistic, kPctMiStatisticNames, statistic);
 }
 
 // The validation section; its defaults follow the Monte Carlo section (seed + 1) and the balls.
@@ -221,9 +248,9 @@ void validate(const StartupProfileSettings& s) {
     throw ConfigError("design.start_frequency_hz", format_number(d.start_frequency_hz), "must be >= 0");
   std::size_t free = 0;
   for (std::size_t i = 0; i < d.segments.size(); ++i) {
-    check_value(d.segments[i].end_frequency_hz, segment_path(i) + ".end_frequency_hz", false);
+    if (!d.segments[i].hold) check_value(d.segments[i].end_frequency_hz, segment_path(i) + ".end_frequency_hz", false);
     check_value(d.segments[i].duration_s, segment_path(i) + ".duration_s", true);
-    free += d.segments[i].end_frequency_hz.free + d.segments[i].duration_s.free;
+    free += (!d.segments[i].hold && d.segments[i].end_frequency_hz.free) + d.segments[i].duration_s.free;
   }
   if (free == 0)
     throw ConfigError("design.segments", std::to_string(d.segments.size()) + " segments, all values fixed",
@@ -247,6 +274,7 @@ void validate(const StartupProfileSettings& s) {
   positive(c.max_startup_time_s, "constraints.max_startup_time_s");
   positive(c.max_amplitude_mm, "constraints.max_amplitude_mm");
   positive(c.max_pct_mi, "constraints.max_pct_mi");
+  positive(c.max_angular_acceleration_rad_s2, "constraints.max_angular_acceleration_rad_s2");
   if (!(std::isfinite(c.penalty_weight) && c.penalty_weight >= 0))
     throw ConfigError("constraints.penalty_weight", format_number(c.penalty_weight), "must be >= 0");
   if (s.validation.runs < 1) throw ConfigError("validation.runs", "0", "must be >= 1");
@@ -261,7 +289,7 @@ StartupProfileProblem::StartupProfileProblem(StartupProfileSettings settings) : 
   for (std::size_t i = 0; i < segs.size(); ++i) {
     for (int which = 0; which < 2; ++which) {
       const DesignValue& v = which == 0 ? segs[i].end_frequency_hz : segs[i].duration_s;
-      if (!v.free) continue;
+      if (!v.free || (which == 0 && segs[i].hold)) continue;
       opt::Variable var;
       var.name = (which == 0 ? "f" : "dt") + std::to_string(i + 1);
       var.lower = v.lower;
@@ -276,6 +304,7 @@ StartupProfileProblem::StartupProfileProblem(StartupProfileSettings settings) : 
   if (c.max_startup_time_s) constraint_names_.push_back("startup_time");
   if (c.max_amplitude_mm) constraint_names_.push_back("amplitude");
   if (c.max_pct_mi) constraint_names_.push_back("pct_mi");
+  if (c.max_angular_acceleration_rad_s2) constraint_names_.push_back("angular_acceleration");
 }
 
 std::vector<std::string> StartupProfileProblem::inequality_names() const { return constraint_names_; }
@@ -299,6 +328,10 @@ StartupProfile StartupProfileProblem::profile_at(const std::vector<double>& x) c
     InclinedSineSegment& g = segs[slots_[k].segment];
     (slots_[k].duration ? g.duration_s : g.end_frequency_hz) = x[k];
   }
+  // Holds take the previous end frequency (the start frequency for the first segment).
+  for (std::size_t i = 0; i < segs.size(); ++i)
+    if (settings_.design.segments[i].hold)
+      segs[i].end_frequency_hz = i == 0 ? settings_.design.start_frequency_hz : segs[i - 1].end_frequency_hz;
   return StartupProfile(std::move(segs), settings_.design.start_frequency_hz);
 }
 
@@ -348,12 +381,24 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
   auto ir = [x_def](const MonteCarloStats& st) -> const ResidualImbalanceStats& {
     return x_def ? st.report_x : st.magnitude;
   };
-  auto objective_of = [&](const MonteCarloStats& st) {
+  const bool smooth_objective = os.kind == ObjectiveKind::SmoothPctMi || os.kind == ObjectiveKind::Quantile ||
+                                os.kind == ObjectiveKind::Cvar;
+  const bool smooth_constraint = settings_.constraints.pct_mi_statistic == PctMiStatistic::Smooth;
+  const bool smooth_wanted = smooth_objective || smooth_constraint;
+  auto objective_of = [&](const MonteCarloStats& st, const std::vector<MonteCarloSample>& samples) {
     const double mean = ir(st).mean / kUnit, pct = ir(st).pct_mi;
     switch (os.kind) {
       case ObjectiveKind::Mean: return mean;
       case ObjectiveKind::PctMi: return pct;
       case ObjectiveKind::Weighted: return os.weight_mean * mean + os.weight_pct_mi * pct;
+      case ObjectiveKind::SmoothPctMi:
+      case ObjectiveKind::Quantile:
+      case ObjectiveKind::Cvar: {
+        const SmoothImbalanceStats sm = compute_smooth_statistics(samples, x_def, os.level);
+        return os.kind == ObjectiveKind::SmoothPctMi ? sm.pct_mi
+               : os.kind == ObjectiveKind::Quantile  ? sm.quantile / kUnit
+                                                     : sm.cvar / kUnit;
+      }
     }
     return mean;
   };
@@ -390,11 +435,13 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
     if (ps.ok == 0)
       return opt::Evaluation::failed("every run failed" +
                                      (mu ? " at friction mu = " + format_number(*mu) : std::string()));
-    objectives.push_back(objective_of(ps));
+    objectives.push_back(objective_of(ps, r.samples));
     pass_pct_mi.push_back(ir(ps).pct_mi);
     for (auto& s : r.samples) pooled.push_back(std::move(s));
   }
   const MonteCarloStats all = compute_statistics(pooled);
+  SmoothImbalanceStats smooth;
+  if (smooth_wanted) smooth = compute_smooth_statistics(pooled, x_def, os.level);
 
   opt::Evaluation e;
   auto& m = e.metrics;
@@ -415,6 +462,13 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
   m["runs"] = static_cast<double>(all.runs);
   m["failed_runs"] = static_cast<double>(all.failed);
   m["mc_wall_time_s"] = wall;
+  if (smooth_wanted) {
+    m["pct_mi_smooth"] = smooth.pct_mi;
+    m["ir_quantile"] = smooth.quantile / kUnit;
+    m["ir_cvar"] = smooth.cvar / kUnit;
+    m["smoothing_bandwidth"] = smooth.bandwidth;
+  }
+  m["peak_angular_acceleration_rad_s2"] = peak_angular_acceleration_rad_s2(profile);
   if (passes.size() > 1 || passes.front()) {
     for (std::size_t k = 0; k < passes.size(); ++k) {
       const std::string tag = std::to_string(k + 1);
@@ -443,7 +497,9 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
     const double a = c.amplitude == AmplitudeStatistic::Max ? all.amplitude_max_mm : all.amplitude_mean_mm;
     g.push_back(a / *c.max_amplitude_mm - 1.0);
   }
-  if (c.max_pct_mi) g.push_back(ir(all).pct_mi / *c.max_pct_mi - 1.0);
+  if (c.max_pct_mi) g.push_back((smooth_constraint ? smooth.pct_mi : ir(all).pct_mi) / *c.max_pct_mi - 1.0);
+  if (c.max_angular_acceleration_rad_s2)
+    g.push_back(peak_angular_acceleration_rad_s2(profile) / *c.max_angular_acceleration_rad_s2 - 1.0);
   e.inequality = std::move(g);
   return e;
 }

@@ -1,19 +1,14 @@
 #include "output_dir.hpp"
 
 #include <cctype>
-#include <fstream>
 
-#include "abuopt/common/config_error.hpp"
+#include "abuopt/common/output_file.hpp"
 
 namespace abuopt::studies_detail {
 
 namespace fs = std::filesystem;
 
-void write_text_file(const fs::path& path, const std::string& text) {
-  std::ofstream f(path);
-  if (!f) throw ConfigError("output file", path.string(), "cannot be written");
-  f << text;
-}
+void write_text_file(const fs::path& path, const std::string& text) { write_file_atomic(path, text); }
 
 std::string table_dir_name(const std::string& id) {
   std::string s = id;

@@ -25,11 +25,7 @@ std::string local_time_text() {
   return buf;
 }
 
-std::string md_escape(const std::string& s) {
-  std::string o;
-  for (char c : s) o += c == '|' ? std::string("\\|") : std::string(1, c);
-  return o;
-}
+std::string md_escape(const std::string& s) { return markdown_cell(s); }
 
 }  // namespace
 

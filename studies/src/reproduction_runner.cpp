@@ -2,11 +2,12 @@
 
 #include <chrono>
 #include <filesystem>
-#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/gnuplot.hpp"
+#include "abuopt/common/output_file.hpp"
 #include "output_dir.hpp"
 #include "reproduction_plots.hpp"
 #include "study_text.hpp"
@@ -23,7 +24,7 @@ ReproductionReport run_reproduction(const std::vector<ReproductionTable>& tables
   std::error_code ec;
   fs::create_directories(out / "runs", ec);
   if (!ec) fs::create_directories(out / "plots", ec);
-  if (ec) throw ConfigError("output directory", opt.out_dir, "cannot be created (" + ec.message() + ")");
+  if (ec) throw OutputError("cannot create the output directory " + opt.out_dir + " (" + ec.message() + ")");
   auto log = [&opt](const std::string& line) {
     if (opt.log) opt.log(line);
   };
@@ -31,9 +32,10 @@ ReproductionReport run_reproduction(const std::vector<ReproductionTable>& tables
   ReproductionReport report;
   report.markdown_path = (out / "report.md").string();
   report.tables_csv_path = (out / "tables.csv").string();
-  std::ofstream tables_csv(report.tables_csv_path);
-  if (!tables_csv) throw ConfigError("output directory", opt.out_dir, "cannot write " + report.tables_csv_path);
-  tables_csv << tables_csv_header() << '\n' << std::flush;
+  // tables.csv is rewritten whole after every case (a few dozen lines): an interrupted study keeps
+  // every finished case, and a failed write never leaves a truncated file under the name.
+  std::string tables_csv = tables_csv_header() + "\n";
+  write_text_file(report.tables_csv_path, tables_csv);
 
   ThreadPoolRunner runner(opt.threads);
   report.concurrency = runner.concurrency();
@@ -47,18 +49,19 @@ ReproductionReport run_reproduction(const std::vector<ReproductionTable>& tables
     const auto t_table = clock::now();
     const fs::path run_dir = out / "runs" / table_dir_name(table.id);
     fs::create_directories(run_dir, ec);
-    if (ec) throw ConfigError("output directory", opt.out_dir, "cannot create " + run_dir.string());
+    if (ec) throw OutputError("cannot create " + run_dir.string() + " (" + ec.message() + ")");
     for (std::size_t k = 0; k < table.cases.size(); ++k) {
       const ReproductionCase& c = table.cases[k];
       MonteCarloResult result = run_monte_carlo(c.study, runner);
       const fs::path csv_path = run_dir / (c.id + ".csv");
       {
-        std::ofstream f(csv_path);
-        if (!f) throw ConfigError("output directory", opt.out_dir, "cannot write " + csv_path.string());
+        std::ostringstream f;
         write_runs_csv(f, result.samples);
+        write_text_file(csv_path, f.str());
       }
       CaseSummary s = summarize_case(table, c, result);
-      tables_csv << tables_csv_line(s) << '\n' << std::flush;
+      tables_csv += tables_csv_line(s) + "\n";
+      write_text_file(report.tables_csv_path, tables_csv);
       ++done_cases;
       const double elapsed = std::chrono::duration<double>(clock::now() - t_start).count();
       // (built piece by piece: GCC 12 warns -Wrestrict on one long "..." + std::string chain here)

@@ -6,6 +6,8 @@
 
 #include <cmath>
 #include <sstream>
+#include <vector>
+#include <stdexcept>
 
 namespace abuopt {
 namespace {
@@ -199,6 +201,81 @@ TEST(MonteCarloStats, CsvHasOneLinePerRunAndRoundTrips) {
   int rest = 0;
   while (std::getline(is, line)) ++rest;
   EXPECT_EQ(rest, 2);
+}
+
+// ---- smooth statistics ----
+
+// Ten ok runs with |I_r| = 1..10 (1e-7 kg m), one failed; the threshold 20e-7 makes r = I_r / 20.
+std::vector<MonteCarloSample> ten_runs() {
+  std::vector<MonteCarloSample> v;
+  for (int k = 1; k <= 10; ++k) v.push_back(sample(k, RunStatus::Ok, k, -k, true, 1, 0.1));
+  v.push_back(sample(11, RunStatus::ChatterLimit, 1000, 1000, true, 1, 0.1));
+  return v;
+}
+
+// Quantile (type 7) and CVaR by hand: level 0.8, h = 9 * 0.8 = 7.2, Q = 8 + 0.2 (9 - 8) = 8.2;
+// CVaR = 8.2 + (0.8 + 1.8) / (10 * 0.2) = 9.5, the mean of the worst 20 % (9, 10). Level 0: the mean.
+TEST(SmoothStatistics, QuantileAndCvarByHand) {
+  const SmoothImbalanceStats s = compute_smooth_statistics(ten_runs(), false, 0.8);
+  EXPECT_EQ(s.count, 10u);
+  EXPECT_NEAR(s.quantile / 1e-7, 8.2, kTol);
+  EXPECT_NEAR(s.cvar / 1e-7, 9.5, kTol);
+  EXPECT_NEAR(compute_smooth_statistics(ten_runs(), false, 0.0).cvar / 1e-7, 5.5, kTol);
+  // I_r,x = -k: quantile of -10..-1 at 0.8 is -2.8
+  EXPECT_NEAR(compute_smooth_statistics(ten_runs(), true, 0.8).quantile / 1e-7, -2.8, kTol);
+  EXPECT_THROW(compute_smooth_statistics(ten_runs(), false, 1.0), std::invalid_argument);
+}
+
+// Silverman's rule: 0.9 sd n^(-1/5); r = k / 20 for k = 1..10 has sd = sqrt(55/6) / 20.
+TEST(SmoothStatistics, BandwidthIsSilvermansRule) {
+  const double sd = std::sqrt(55.0 / 6.0) / 20.0;
+  const SmoothImbalanceStats s = compute_smooth_statistics(ten_runs(), false, 0.9);
+  EXPECT_NEAR(s.bandwidth, 0.9 * sd * std::pow(10.0, -0.2), 1e-15);
+  EXPECT_EQ(smoothing_bandwidth({1.0}), 0.0);
+  EXPECT_EQ(smoothing_bandwidth({2.0, 2.0, 2.0}), 0.0);
+}
+
+// The smoothed exceedance: Phi((r - 1) / h) summed by hand for the ten runs (no run exceeds:
+// exact %MI 0, smoothed small but positive), and a run crossing its threshold moves it
+// continuously where the count jumps by 100/n.
+TEST(SmoothStatistics, SmoothedExceedanceByHandAndContinuousAcrossTheThreshold) {
+  const SmoothImbalanceStats s = compute_smooth_statistics(ten_runs(), false, 0.9);
+  double p = 0;
+  for (int k = 1; k <= 10; ++k) p += 0.5 * std::erfc(-(k / 20.0 - 1.0) / (s.bandwidth * std::sqrt(2.0)));
+  EXPECT_NEAR(s.pct_mi, 10.0 * p, 1e-12);
+  EXPECT_GT(s.pct_mi, 0.0);
+  EXPECT_EQ(compute_statistics(ten_runs()).magnitude.pct_mi, 0.0);
+
+  auto with_last = [](double mag_e7) {
+    std::vector<MonteCarloSample> v = ten_runs();
+    v[9].outcome.residual_imbalance_kgm = mag_e7 * 1e-7;
+    return v;
+  };
+  const auto below = with_last(19.999), above = with_last(20.001);  // r = 0.99995, 1.00005
+  EXPECT_NEAR(compute_statistics(above).magnitude.pct_mi - compute_statistics(below).magnitude.pct_mi, 10.0, kTol);
+  const double jump = compute_smooth_statistics(above, false, 0.9).pct_mi -
+                      compute_smooth_statistics(below, false, 0.9).pct_mi;
+  EXPECT_GT(jump, 0.0);
+  EXPECT_LT(jump, 0.01);  // ~ 100/n * 1e-4 / h * phi(0): continuous
+}
+
+// As n grows the bandwidth shrinks as n^(-1/5) and the smoothed value tends to the count: r
+// evenly spread on [0, 4] (exact exceedance 3/4; interior smoothing of a uniform density is exact,
+// what is left is the edge at 0, below Phi(-1/h)).
+TEST(SmoothStatistics, TendsToTheCountAsRunsGrow) {
+  double previous_gap = 1.0;
+  for (int n : {64, 1024, 16384}) {
+    std::vector<MonteCarloSample> v;
+    for (int i = 0; i < n; ++i) v.push_back(sample(i, RunStatus::Ok, 80.0 * (i + 0.5) / n, 0, true, 1, 0.1));
+    const SmoothImbalanceStats s = compute_smooth_statistics(v, false, 0.9);
+    const double exact = compute_statistics(v).magnitude.pct_mi;
+    EXPECT_NEAR(exact, 75.0, 100.0 / n);
+    EXPECT_NEAR(s.bandwidth, 0.9 * (4.0 / std::sqrt(12.0)) * std::pow(n, -0.2), 0.01);
+    const double gap = std::fabs(s.pct_mi - exact);
+    EXPECT_LT(gap, previous_gap);
+    previous_gap = gap;
+  }
+  EXPECT_LT(previous_gap, 0.05);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // The SQLite evaluation archive: exact (bitwise) lookups, exact values, a caching problem that
-// never evaluates a point twice, and a study killed with SIGKILL that resumes without
-// re-evaluating anything it had stored.
+// never evaluates a point twice, a study killed with SIGKILL that resumes without re-evaluating
+// anything it had stored, and damage: a flipped byte in a stored value is detected by the row's
+// checksum and recomputed, garbage in the file is an error naming it, a schema version is checked.
 #include "abuopt/optimizer/evaluation_archive.hpp"
 
 #include <gtest/gtest.h>
@@ -8,9 +9,14 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <sqlite3.h>
+
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <set>
 #include <thread>
 
@@ -255,6 +261,166 @@ TEST(ArchivedProblem, ConcurrentEvaluationsAreSafe) {
   EXPECT_EQ(archive.count(), 100);
   EXPECT_EQ(ap.hits() + ap.misses(), 200);
   EXPECT_GE(ap.hits(), 0);
+}
+
+// ---- damage: every stored evaluation carries a checksum, the file a schema version ----
+
+// The file's bytes (after the archive is closed, so the WAL is folded into it).
+std::string file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+void write_bytes(const std::string& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+// One flipped byte in a stored value: the archive must not answer with it (the value would be
+// wrong, and SQLite's own integrity check does not see it). The row is recomputed, and said.
+TEST(EvaluationArchive, AFlippedByteInAStoredValueIsDetectedAndTheRowRecomputed) {
+  const std::string path = archive_path("flipped");
+  CountingRosenbrock p;
+  const std::vector<double> x = {0.25, -0.5};
+  const Evaluation truth = p.evaluate(x);
+  {
+    EvaluationArchive a(path, "p");
+    ArchivedProblem ap(p, a);
+    ap.evaluate(x);
+  }
+  // the objective's exact bits as the archive writes them (16 hex digits)
+  std::string bytes = file_bytes(path);
+  const std::string key = EvaluationArchive::key_of({truth.objective});
+  const std::size_t at = bytes.find(key);
+  ASSERT_NE(at, std::string::npos);
+  bytes[at + 1] = bytes[at + 1] == '0' ? '8' : '0';  // a large change of the stored value
+  write_bytes(path, bytes);
+
+  EvaluationArchive a(path, "p");
+  std::vector<std::string> said;
+  a.set_warning_handler([&](const std::string& w) { said.push_back(w); });
+  EXPECT_FALSE(a.find(x).has_value());  // not the damaged value
+  ASSERT_EQ(said.size(), 1u);
+  EXPECT_NE(said[0].find(path), std::string::npos) << said[0];
+  EXPECT_NE(said[0].find("checksum"), std::string::npos) << said[0];
+  EXPECT_EQ(a.damaged_rows(), 1);
+  // recomputed through the archived problem, stored again, then answered correctly
+  const long calls = p.calls;
+  ArchivedProblem ap(p, a);
+  const Evaluation e = ap.evaluate(x);
+  EXPECT_EQ(p.calls, calls + 1);
+  EXPECT_EQ(e.objective, truth.objective);
+  const auto again = a.find(x);
+  ASSERT_TRUE(again.has_value());
+  EXPECT_EQ(again->objective, truth.objective);
+  for (const auto& en : a.entries()) EXPECT_EQ(en.evaluation.objective, truth.objective);
+}
+
+// Damage in any field that is read back (a metric here) is detected too.
+TEST(EvaluationArchive, ADamagedMetricIsDetected) {
+  const std::string path = archive_path("metric");
+  CountingRosenbrock p;
+  const std::vector<double> x = {0.75, 0.5};
+  {
+    EvaluationArchive a(path, "p");
+    ArchivedProblem ap(p, a);
+    ap.evaluate(x);
+  }
+  std::string bytes = file_bytes(path);
+  const std::size_t at = bytes.find("\"distance\":");
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t digit = bytes.find_first_of("123456789", at + 11);
+  ASSERT_NE(digit, std::string::npos);
+  bytes[digit] = bytes[digit] == '9' ? '1' : static_cast<char>(bytes[digit] + 1);
+  write_bytes(path, bytes);
+  EvaluationArchive a(path, "p");
+  a.set_warning_handler([](const std::string&) {});
+  EXPECT_FALSE(a.find(x).has_value());
+  EXPECT_TRUE(a.entries().empty());  // the damaged row informs nobody
+  EXPECT_EQ(a.damaged_rows(), 1);
+}
+
+// Garbage in the middle of the file: the archive is not trusted at all; the error names the file.
+TEST(EvaluationArchive, GarbageInTheMiddleOfTheFileIsAnErrorNamingTheFile) {
+  const std::string path = archive_path("garbage");
+  {
+    CountingRosenbrock p;
+    EvaluationArchive a(path, "p");
+    ArchivedProblem ap(p, a);
+    for (int i = 0; i < 400; ++i) ap.evaluate({-1.5 + 0.007 * i, 0.3});
+  }
+  std::string bytes = file_bytes(path);
+  ASSERT_GT(bytes.size(), 40000u);  // several pages
+  std::uint64_t state = 12345;
+  for (std::size_t i = bytes.size() / 2; i < bytes.size() / 2 + 3000; ++i) {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    bytes[i] = static_cast<char>(state >> 56);
+  }
+  write_bytes(path, bytes);
+  try {
+    EvaluationArchive a(path, "p");
+    CountingRosenbrock p;
+    ArchivedProblem ap(p, a);
+    for (int i = 0; i < 400; ++i) ap.evaluate({-1.5 + 0.007 * i, 0.3});
+    a.entries();
+    ADD_FAILURE() << "a damaged archive was used";
+  } catch (const abuopt::ConfigError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find(path), std::string::npos) << m;
+    EXPECT_NE(m.find("damaged"), std::string::npos) << m;
+  }
+}
+
+// The schema version: written on creation, checked on opening, with a clear message.
+TEST(EvaluationArchive, SchemaVersionIsWrittenAndCheckedWithAClearMessage) {
+  const std::string path = archive_path("version");
+  { EvaluationArchive a(path, "p"); }
+  { EvaluationArchive a(path, "p"); }  // its own version opens again
+  EXPECT_EQ(EvaluationArchive::schema_version(), 2);
+  // an archive of the first layout (no version, no checksums)
+  const std::string old = archive_path("version_old");
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(old.c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db,
+                           "CREATE TABLE evaluations (id INTEGER PRIMARY KEY AUTOINCREMENT, problem_id TEXT NOT NULL,"
+                           " x_key TEXT NOT NULL, x TEXT NOT NULL, objective REAL, values_hex TEXT NOT NULL,"
+                           " n_inequality INTEGER NOT NULL, inequality TEXT NOT NULL, equality TEXT NOT NULL,"
+                           " metrics TEXT NOT NULL, ok INTEGER NOT NULL, message TEXT NOT NULL, wall_time_s REAL,"
+                           " timestamp TEXT NOT NULL, UNIQUE(problem_id, x_key))",
+                           nullptr, nullptr, nullptr),
+              SQLITE_OK);
+    sqlite3_close(db);
+  }
+  try {
+    EvaluationArchive a(old, "p");
+    ADD_FAILURE() << "an archive of another schema version was opened";
+  } catch (const abuopt::ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), "evaluation archive '" + old +
+                                         "' has schema version 0; this abuopt reads version 2 (checksums and "
+                                         "run counts per evaluation): move it away or delete it (its evaluations "
+                                         "are recomputed)");
+  }
+}
+
+// The Monte Carlo run count is part of the key: a value computed with 16 runs never answers a
+// request for 32 (nothing stale is reused), and both are kept.
+TEST(EvaluationArchive, RunCountIsPartOfTheKey) {
+  const std::string path = archive_path("runs");
+  EvaluationArchive a(path, "p");
+  Evaluation e16, e32;
+  e16.objective = 1.5;
+  e32.objective = 1.25;
+  const std::vector<double> x = {0.5, 0.5};
+  a.store(x, e16, 0.0, 16);
+  EXPECT_FALSE(a.find(x, 32).has_value());
+  EXPECT_FALSE(a.find(x).has_value());  // 0: no run count
+  a.store(x, e32, 0.0, 32);
+  EXPECT_EQ(a.find(x, 16)->objective, 1.5);
+  EXPECT_EQ(a.find(x, 32)->objective, 1.25);
+  const auto entries = a.entries();
+  ASSERT_EQ(entries.size(), 2u);
+  EXPECT_EQ(entries[0].runs, 16);
+  EXPECT_EQ(entries[1].runs, 32);
 }
 
 }  // namespace

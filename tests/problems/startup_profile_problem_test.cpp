@@ -169,6 +169,40 @@ TEST(StartupProfileProblem, ObjectiveKindsMatchTheEngineStatistics) {
   EXPECT_DOUBLE_EQ(w.evaluate(x).objective, 2 * st.magnitude.mean / 1e-7 + 0.5 * st.magnitude.pct_mi);
 }
 
+// The smooth objectives are core's smooth statistics of the same runs; the pct_mi constraint can use
+// the smoothed exceedance; the identity changes with them and not for the older keys.
+TEST(StartupProfileProblem, SmoothObjectivesAndConstraintAreTheEngineSmoothStatistics) {
+  const std::vector<double> x = {35, 0.4};
+  StartupProfileProblem base(settings_from(tiny("{kind: mean}")));
+  MonteCarloStudy study = base.settings().study;
+  study.setup.profile = base.profile_at(x);
+  ThreadPoolRunner runner(1);
+  const std::vector<MonteCarloSample> samples = run_monte_carlo(study, runner).samples;
+  const SmoothImbalanceStats s90 = compute_smooth_statistics(samples, false, 0.9);
+  const SmoothImbalanceStats s75 = compute_smooth_statistics(samples, false, 0.75);
+
+  StartupProfileProblem smooth(settings_from(tiny("{kind: smooth_pct_mi}")));
+  const opt::Evaluation e = smooth.evaluate(x);
+  ASSERT_TRUE(e.ok) << e.message;
+  EXPECT_DOUBLE_EQ(e.objective, s90.pct_mi);
+  EXPECT_DOUBLE_EQ(e.metrics.at("pct_mi_smooth"), s90.pct_mi);
+  EXPECT_DOUBLE_EQ(e.metrics.at("smoothing_bandwidth"), s90.bandwidth);
+  StartupProfileProblem q(settings_from(tiny("{kind: quantile, level: 0.75}")));
+  EXPECT_DOUBLE_EQ(q.evaluate(x).objective, s75.quantile / 1e-7);
+  StartupProfileProblem cv(settings_from(tiny("{kind: cvar}")));
+  EXPECT_DOUBLE_EQ(cv.evaluate(x).objective, s90.cvar / 1e-7);
+  EXPECT_GE(cv.evaluate(x).objective, q.evaluate(x).objective);
+
+  StartupProfileProblem g(settings_from(tiny("{kind: mean}", "{max_pct_mi: 40, pct_mi_statistic: smooth}")));
+  EXPECT_DOUBLE_EQ(g.evaluate(x).inequality.at(0), s90.pct_mi / 40 - 1.0);
+  EXPECT_FALSE(base.evaluate(x).metrics.count("pct_mi_smooth"));  // the default outputs are unchanged
+
+  EXPECT_NE(q.identity(), StartupProfileProblem(settings_from(tiny("{kind: quantile, level: 0.8}"))).identity());
+  EXPECT_NE(g.identity(), StartupProfileProblem(settings_from(tiny("{kind: mean}", "{max_pct_mi: 40}"))).identity());
+  EXPECT_EQ(error_of([] { settings_from(tiny("{kind: mean, level: 0.5}")); }),
+            "objective.level = 0.5: is only used with objective.kind: quantile or cvar");
+}
+
 TEST(StartupProfileProblem, RobustObjectiveIsTheMeanOverFrictionValues) {
   const std::vector<double> x = {35, 0.4};
   StartupProfileProblem robust(settings_from(tiny("{kind: weighted, weights: {mean: 1, pct_mi: 1}, robust: {friction_mu: [0.02, 0.04]}}")));
@@ -375,7 +409,7 @@ TEST(StartupProfileProblem, ConfigErrorsNameKeyValueAndRule) {
   EXPECT_EQ(err(head), "design = <missing>: is required (design: {segments: [...]} with at least one free {min, max} value)");
   const std::string design = "design: {segments: [{end_frequency_hz: 30, duration_s: {min: 1, max: 2}}]}\n";
   EXPECT_EQ(err(head + design + "objective: {kind: median}\n"),
-            "objective.kind = median: must be one of: mean, pct_mi, weighted");
+            "objective.kind = median: must be one of: mean, pct_mi, weighted, smooth_pct_mi, quantile, cvar");
   EXPECT_EQ(err(head + design + "objective: {kind: mean, weights: {mean: 1}}\n"),
             "objective.weights = {mean: 1}: is only used with objective.kind: weighted");
   EXPECT_EQ(err(head + design + "objective: {kind: weighted, weights: {mean: 0, pct_mi: 0}}\n"),
@@ -389,4 +423,73 @@ TEST(StartupProfileProblem, ConfigErrorsNameKeyValueAndRule) {
             "constraints.max_startup = 20: unknown key (misspelt, or not valid here)");
   EXPECT_EQ(err(head + design + "validation: {design: grid, grid: 4, runs: 10}\n"),
             "validation.runs = 10: must equal validation.grid^balls = 16 with the grid design");
+}
+
+// A hold segment takes the previous end frequency (a dwell, no variable); frequencies may fall.
+TEST(StartupProfileProblem, HoldSegmentsDwellAtThePreviousFrequency) {
+  StartupProfileProblem p(settings_from(R"(
+montecarlo: {design: grid, grid: 2, threads: 1}
+design:
+  segments:
+    - end_frequency_hz: {min: 20, max: 35, x0: 30}
+      duration_s: 1
+    - hold: true
+      duration_s: {min: 0.5, max: 5, x0: 2}
+    - end_frequency_hz: {min: 20, max: 35, x0: 28}
+      duration_s: 3
+    - {end_frequency_hz: 100, duration_s: 8}
+)"));
+  ASSERT_EQ(p.variables().size(), 3u);
+  EXPECT_EQ(p.variables()[0].name, "f1");
+  EXPECT_EQ(p.variables()[1].name, "dt2");
+  EXPECT_EQ(p.variables()[2].name, "f3");
+  const auto prof = p.profile_at({31.5, 2.5, 27});
+  ASSERT_EQ(prof.segments().size(), 4u);
+  EXPECT_DOUBLE_EQ(prof.segments()[1].end_frequency_hz, 31.5);
+  EXPECT_DOUBLE_EQ(prof.frequency_hz(1.0 + 1.3), 31.5);  // constant through the hold
+  EXPECT_DOUBLE_EQ(prof.segments()[2].end_frequency_hz, 27);  // falling segment
+  EXPECT_NE(p.identity_text().find("hold: true"), std::string::npos);
+  // hold replaces end_frequency_hz: both in one segment is an error naming the key.
+  EXPECT_NE(error_of([] {
+              settings_from("montecarlo: {design: grid, grid: 2, threads: 1}\ndesign:\n  segments:\n"
+                            "    - {hold: true, end_frequency_hz: 30, duration_s: {min: 1, max: 2}}\n");
+            }).find("end_frequency_hz"),
+            std::string::npos);
+  // A hold first segment dwells at the start frequency.
+  StartupProfileProblem first(settings_from(R"(
+montecarlo: {design: grid, grid: 2, threads: 1}
+design:
+  start_frequency_hz: 5
+  segments:
+    - {hold: true, duration_s: 1}
+    - end_frequency_hz: {min: 20, max: 35}
+      duration_s: 2
+)"));
+  EXPECT_DOUBLE_EQ(first.profile_at({30}).segments()[0].end_frequency_hz, 5);
+}
+
+// The peak angular acceleration of an inclined sine of height H in dt s is 2 pi * 2 |H| / dt (at its
+// middle, f' = 2 H / dt); the report's profile peaks in its first segment, 2 pi * 50 = 314.16 rad/s^2.
+TEST(StartupProfileProblem, AngularAccelerationConstraintIsExact) {
+  const StartupProfile report = StartupProfile::report_final();
+  EXPECT_NEAR(problems::peak_angular_acceleration_rad_s2(report), 2 * M_PI * 50, 1e-9);
+  // Against the profile's own derivative, sampled finely: the same peak, and a falling segment counts.
+  const StartupProfile falling({{30, 1}, {26, 0.5}, {100, 8}});
+  double peak = 0;
+  for (double t = 0; t < falling.duration_s(); t += 1e-4)
+    peak = std::max(peak, 2 * M_PI * std::abs(falling.sample(t).rate_hz_per_s));
+  EXPECT_NEAR(problems::peak_angular_acceleration_rad_s2(falling), peak, 1e-3 * peak);
+  EXPECT_NEAR(peak, 2 * M_PI * 2 * 30, 1e-3 * peak);  // the first segment: 2 * 30 Hz / 1 s
+  const std::vector<double> x = {35, 0.4};
+  StartupProfileProblem p(settings_from(tiny("{kind: mean}", "{max_angular_acceleration_rad_s2: 500}")));
+  ASSERT_EQ(p.inequality_names(), (std::vector<std::string>{"angular_acceleration"}));
+  const opt::Evaluation e = p.evaluate(x);
+  ASSERT_TRUE(e.ok) << e.message;
+  EXPECT_DOUBLE_EQ(e.inequality[0], 2 * M_PI * 2 * 35 / 0.4 / 500 - 1.0);
+  EXPECT_DOUBLE_EQ(e.metrics.at("peak_angular_acceleration_rad_s2"), 2 * M_PI * 2 * 35 / 0.4);
+  // The limit decides the constraint values, so it is part of the problem identity (archive key).
+  EXPECT_NE(StartupProfileProblem(settings_from(tiny("{kind: mean}"))).identity(), p.identity());
+  EXPECT_NE(error_of([] { settings_from(tiny("{kind: mean}", "{max_angular_acceleration_rad_s2: -1}")); })
+                .find("constraints.max_angular_acceleration_rad_s2"),
+            std::string::npos);
 }

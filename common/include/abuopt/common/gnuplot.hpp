@@ -1,6 +1,7 @@
 #pragma once
 // A small gnuplot driver: writes a script beside the data CSV and runs `gnuplot script.gp` to make
-// a PNG. Plotting is optional: without gnuplot the script is still written and the status says
+// a PNG. gnuplot is started with posix_spawn and an argument vector: no shell sees any path or
+// text. A script that cannot be written throws OutputError (output_file.hpp). Plotting is optional: without gnuplot the script is still written and the status says
 // "skipped: gnuplot not found", so a study never fails for want of a plot.
 //
 //   Gnuplot gp;                                   // finds gnuplot (see find())
@@ -109,6 +110,11 @@ class Gnuplot {
   PlotStatus run(const std::string& script_body, const std::string& script_path, const std::string& png_path,
                  int width_px = 900, int height_px = 650) const;
 
+  // Runs gnuplot on an existing script (argument vector, no shell), in `working_dir` when not
+  // empty, with its output in `log_path`. Returns gnuplot's exit status; -1 when it could not be
+  // started or was killed (the reason is in the log) or when no gnuplot is available.
+  int run_script(const std::string& script_path, const std::string& working_dir, const std::string& log_path) const;
+
   PlotStatus xy_lines(const XYLinesPlot& p) const;
   PlotStatus scatter(const ScatterPlot& p) const;
   PlotStatus grid(const GridPlot& p) const;
@@ -122,7 +128,9 @@ class Gnuplot {
 
   // <csv dir>/<png stem><suffix>
   static std::string beside_csv(const PlotFiles& f, const std::string& suffix);
-  // A gnuplot single-quoted string literal ('it''s').
+  // A gnuplot single-quoted string literal ('it''s'). Every text that reaches a script (labels,
+  // titles, file names) goes through it: quotes are doubled and control characters (newline, CR,
+  // tab, ...) become spaces, so no text can end the string or the line and add a command.
   static std::string quote(const std::string& text);
 
  private:

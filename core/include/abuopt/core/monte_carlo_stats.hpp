@@ -88,6 +88,33 @@ nlohmann::json to_json(const MonteCarloStats& s);
 // Human-readable multi-line summary (both definitions, kg m in units of 1e-7 as in the report).
 std::string format_summary(const MonteCarloStats& s);
 
+// ---- Smooth statistics (docs/montecarlo.md, "Smooth statistics"): for optimisation only ----
+// Under common random numbers the count %MI is piecewise constant in the design (it moves in steps
+// of 100/n when one run's I_r crosses its threshold). These are continuous in the runs' values:
+//   smoothed exceedance  p_h = (1/n) sum_i Phi((r_i - 1) / h),  r_i = I_r,i / I_i (I_i the run's
+//     threshold, as for %MI), Phi the standard normal CDF (a Gaussian-kernel smoothed indicator),
+//     h = 0.9 sd(r) n^(-1/5) (Silverman's rule on the sample: shrinks with n, so p_h tends to the
+//     count); h = 0 (all r equal) gives the count itself.
+//   quantile             Q(level) of I_r, type 7 (continuous in the values).
+//   CVaR                 Q + (1 / (n (1 - level))) sum_i max(0, I_r,i - Q)  (Rockafellar-Uryasev:
+//     the mean of the worst (1 - level) fraction; level 0 gives the mean).
+// Failed runs are excluded, as everywhere. Validation and every reported figure use the exact
+// statistics (compute_statistics).
+struct SmoothImbalanceStats {
+  std::size_t count = 0;     // ok runs
+  double bandwidth = 0;      // h (ratio units)
+  double pct_mi = 0;         // 100 p_h, percent
+  double level = 0.9;
+  double quantile = 0;       // kg m
+  double cvar = 0;           // kg m
+};
+// Silverman's bandwidth 0.9 sd n^(-1/5) of a sample (0 for fewer than 2 values).
+double smoothing_bandwidth(const std::vector<double>& values);
+// `report_x`: the report's I_r,x instead of |I_r|. level in [0, 1) (std::invalid_argument
+// otherwise). No ok run: NaN statistics, count 0.
+SmoothImbalanceStats compute_smooth_statistics(const std::vector<MonteCarloSample>& samples, bool report_x,
+                                               double level);
+
 // Per-run CSV: header, then one line per sample in index order. Columns:
 // index, beta0_1..beta0_N, mu, imbalance_mass_kg (empty when nominal), imbalance_angle_rad,
 // beta_final_1..beta_final_N, ir_magnitude_kgm, ir_x_kgm, settled, settling_time_s,

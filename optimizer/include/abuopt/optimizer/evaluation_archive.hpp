@@ -13,12 +13,23 @@
 //   (even SIGKILL) loses nothing that store() returned from (synchronous=NORMAL: an OS crash or
 //   power loss may lose the last few commits).
 // * Thread-safe: every method takes a mutex.
+// * Integrity: every stored evaluation carries a checksum (FNV-1a 64 of everything read back:
+//   problem id, x, run count, values, inequality count, metrics, status, message), verified on
+//   every read. A row that fails it is damaged: it is deleted, never answered (find() misses, so
+//   ArchivedProblem recomputes and stores it again; entries() leaves it out), and said through the
+//   warning handler (default: a line on stderr). A file that SQLite itself finds damaged
+//   (PRAGMA quick_check on opening, or a corruption error later) is a ConfigError naming the file.
+// * Schema version: PRAGMA user_version = schema_version() (2: checksums and run counts); an
+//   archive of another version is a ConfigError that says so (it is not migrated).
+// * Run count: a value is stored with the Monte Carlo run count it was computed with (0: not a
+//   sampled problem), which is part of the key: a request at another run count never gets it.
 //
 // ArchivedProblem decorates any Problem: evaluate(x) first asks the archive; a hit is returned
 // with Evaluation::from_archive = true (and counted by minimize() in archive_hits), a miss is
 // evaluated by the wrapped problem and stored. Failed evaluations (ok == false) are stored too
 // (a rerun would fail the same way); evaluations that throw are not stored.
 #include <atomic>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -36,12 +47,14 @@ class EvaluationArchive {
   struct Entry {
     long id = 0;
     std::vector<double> x;
+    long runs = 0;  // Monte Carlo runs of the value (0: not a sampled problem)
     Evaluation evaluation;
     double wall_time_s = 0.0;
     std::string timestamp;  // ISO 8601, UTC
   };
 
-  // Opens or creates the archive file; throws abuopt::ConfigError naming the file if it cannot.
+  // Opens or creates the archive file; throws abuopt::ConfigError naming the file if it cannot, if
+  // SQLite finds it damaged, or if it has another schema version.
   EvaluationArchive(const std::string& path, std::string problem_id);
   ~EvaluationArchive();
   EvaluationArchive(const EvaluationArchive&) = delete;
@@ -50,14 +63,23 @@ class EvaluationArchive {
   const std::string& path() const { return path_; }
   const std::string& problem_id() const { return problem_id_; }
 
-  // The stored evaluation of exactly x (bitwise) for this problem id, if any.
-  std::optional<Evaluation> find(const std::vector<double>& x) const;
-  // Stores one evaluation and commits. A repeat of an x already stored is ignored (first wins).
-  void store(const std::vector<double>& x, const Evaluation& evaluation, double wall_time_s);
+  // The stored evaluation of exactly x (bitwise) at this run count for this problem id, if any and
+  // intact (a damaged row is deleted, said, and not returned).
+  std::optional<Evaluation> find(const std::vector<double>& x, long runs = 0) const;
+  // Stores one evaluation with its checksum and commits. A repeat of an (x, runs) already stored is
+  // ignored (first wins).
+  void store(const std::vector<double>& x, const Evaluation& evaluation, double wall_time_s, long runs = 0);
   // Number of evaluations stored for this problem id.
   long count() const;
-  // All evaluations of this problem id, in the order they were stored.
+  // All intact evaluations of this problem id, in the order they were stored.
   std::vector<Entry> entries() const;
+
+  // Where warnings about damaged rows go (default: "warning: ..." on stderr).
+  void set_warning_handler(std::function<void(const std::string&)> handler);
+  // Rows found damaged (and deleted) since this archive was opened.
+  long damaged_rows() const { return damaged_.load(); }
+  // The PRAGMA user_version this code writes and reads.
+  static int schema_version();
 
   // Records the problem's variable and constraint names under this problem id, or, if already
   // recorded, throws abuopt::ConfigError when they differ (an id reused for another problem).
@@ -68,10 +90,14 @@ class EvaluationArchive {
 
  private:
   void exec(const char* sql) const;
+  // A row whose checksum fails: deleted, counted, said (mutex held by the caller).
+  void discard_damaged(long id, const std::string& what) const;
   std::string path_;
   std::string problem_id_;
   sqlite3* db_ = nullptr;
   mutable std::mutex mutex_;
+  std::function<void(const std::string&)> warn_;
+  mutable std::atomic<long> damaged_{0};
 };
 
 class ArchivedProblem : public Problem {

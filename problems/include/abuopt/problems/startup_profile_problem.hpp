@@ -16,6 +16,11 @@
 //   mean:      mean I_r
 //   pct_mi:    %MI (piecewise constant in x: a step of 100/runs; prefer mean or weighted)
 //   weighted:  w_mean * mean I_r + w_pct_mi * %MI
+//   smooth_pct_mi, quantile, cvar: the smooth statistics of core (compute_smooth_statistics: the
+//              smoothed exceedance in percent, the |I_r| quantile and CVaR at objective.level), for
+//              optimisers; validation and reports stay on the exact ones. With them (and with
+//              constraints.pct_mi_statistic: smooth) the metrics add pct_mi_smooth, ir_quantile,
+//              ir_cvar and smoothing_bandwidth.
 // Robust (objective.robust.friction_mu = [mu_1..mu_K]): the objective is the average over k of the
 // objective of the Monte Carlo run with friction fixed to mu_k (same initial conditions for every
 // k); constraints and metrics use the pooled statistics of all K x runs runs (pooled %MI = average
@@ -25,7 +30,9 @@
 //   startup_time:  T_profile / max_startup_time_s - 1 <= 0      (T_profile = sum of durations)
 //   amplitude:     A / max_amplitude_mm - 1 <= 0, A = max over runs of the peak amplitude
 //                  (amplitude: max, default) or the mean over runs of it (amplitude: mean)
-//   pct_mi:        %MI / max_pct_mi - 1 <= 0                    (definition of the objective)
+//   pct_mi:        %MI / max_pct_mi - 1 <= 0                    (definition of the objective; the
+//                  smoothed exceedance with constraints.pct_mi_statistic: smooth)
+//   angular_acceleration: a / max_angular_acceleration_rad_s2 - 1 <= 0, a = peak_angular_acceleration_rad_s2
 // The problem always declares its constraints. With constraints.penalty_weight = w > 0 the
 // optimisers see its penalty form instead (make_startup_profile_problem, opt::PenaltyProblem): no
 // declared constraints (for bound-only optimisers), objective + w * sum_i max(0, g_i) (exact L1).
@@ -68,7 +75,8 @@ struct DesignValue {
 };
 
 struct SegmentDesign {
-  DesignValue end_frequency_hz;  // variable name f<i> (1-based)
+  bool hold = false;             // a dwell: end frequency = the previous end (start) frequency, no variable
+  DesignValue end_frequency_hz;  // variable name f<i> (1-based); unused with hold
   DesignValue duration_s;        // variable name dt<i>
 };
 
@@ -77,12 +85,17 @@ struct ProfileDesign {
   std::vector<SegmentDesign> segments;
 };
 
-enum class ObjectiveKind { Mean, PctMi, Weighted };
+enum class ObjectiveKind { Mean, PctMi, Weighted, SmoothPctMi, Quantile, Cvar };
 enum class ImbalanceDefinition { Magnitude, ReportX };
 enum class AmplitudeStatistic { Max, Mean };
-extern const EnumNames<ObjectiveKind> kObjectiveKindNames;              // mean, pct_mi, weighted
+// mean, pct_mi, weighted, smooth_pct_mi, quantile, cvar
+extern const EnumNames<ObjectiveKind> kObjectiveKindNames;
 extern const EnumNames<ImbalanceDefinition> kImbalanceDefinitionNames;  // magnitude, report_x
 extern const EnumNames<AmplitudeStatistic> kAmplitudeStatisticNames;    // max, mean
+// Which %MI the pct_mi constraint bounds: the count, or the smoothed exceedance (core's
+// compute_smooth_statistics).
+enum class PctMiStatistic { Exact, Smooth };
+extern const EnumNames<PctMiStatistic> kPctMiStatisticNames;  // exact, smooth
 std::string to_string(ObjectiveKind k);
 std::string to_string(ImbalanceDefinition d);
 std::string to_string(AmplitudeStatistic a);
@@ -92,6 +105,7 @@ struct ObjectiveSettings {
   ImbalanceDefinition definition = ImbalanceDefinition::Magnitude;
   double weight_mean = 1.0;    // weighted: per 1e-7 kg m of mean I_r
   double weight_pct_mi = 0.0;  // weighted: per percent of %MI
+  double level = 0.9;          // quantile, cvar: the level (in (0, 1))
   // Robust objective: average over these friction coefficients; empty: one pass with the
   // montecarlo section's friction (nominal abu.friction_mu by default).
   std::vector<double> robust_friction_mu;
@@ -104,6 +118,10 @@ struct ConstraintSettings {
   std::optional<double> max_amplitude_mm;
   AmplitudeStatistic amplitude = AmplitudeStatistic::Max;
   std::optional<double> max_pct_mi;
+  PctMiStatistic pct_mi_statistic = PctMiStatistic::Exact;
+  // Peak angular acceleration of the profile, max over segments of 2 pi * 2 |H| / dt [rad/s^2]
+  // (exact, no noise): what the drive must be able to follow.
+  std::optional<double> max_angular_acceleration_rad_s2;
   double penalty_weight = 0.0;  // > 0: optimised in penalty form (make_startup_profile_problem)
 };
 
@@ -149,6 +167,10 @@ ProfileDesign read_profile_design(YamlReader design, const StartupProfile& profi
 // Throws ConfigError for an invalid design (no free variable, bounds reversed, x0 outside the
 // bounds, durations not > 0, ...), objective or constraint settings.
 void validate(const StartupProfileSettings& s);
+
+// Peak angular acceleration of a profile [rad/s^2]: an inclined sine of height H and duration dt
+// peaks at f' = 2 |H| / dt (at its middle), so a = max over segments of 2 pi * 2 |H| / dt.
+double peak_angular_acceleration_rad_s2(const StartupProfile& profile);
 
 // FNV-1a, 64 bits.
 std::uint64_t fnv1a64(std::string_view text);

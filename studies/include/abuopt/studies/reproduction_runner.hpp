@@ -12,7 +12,8 @@ namespace abuopt {
 //   tables.csv                     one line per case (ours and the report's), appended per case
 //   report.md                      tables, verdicts, settings, wall time (rewritten per table)
 //   plots/<name>.csv, .gp, .png    the plots the tables ask for (gnuplot helper)
-// Nothing already computed is lost if the study is interrupted. Throws ConfigError when the
+// Nothing already computed is lost if the study is interrupted; every file is written whole
+// (write_file_atomic) and tables.csv is rewritten after each case. Throws OutputError when the
 // output directory cannot be written.
 ReproductionReport run_reproduction(const std::vector<ReproductionTable>& tables, const ReproductionOptions& opt);
 

@@ -1,0 +1,544 @@
+#!/usr/bin/env python3
+"""The ADOPT startup-profile case study (issue 10), one command: docs/studies/startup-profile.md.
+
+    scripts/startup_study.py                      # everything, into results/startup_study/
+    scripts/startup_study.py --out DIR --threads 2 --abuopt build/app/abuopt
+    scripts/startup_study.py --scale 4            # 4x the Monte Carlo runs and evaluations
+
+Stages (each resumable: an optimisation replays its evaluation archive, a finished validation is
+kept; rerun the same command after an interruption):
+  1. formulation 1, per profile family (configs/studies/f1_*.yaml): global phase (DIRECT_L, L1
+     penalty, 64 LHS starts, bounds only) then the local polish (COBYLA, 256 starts) from the global
+     best; the 3-segment family also polished from the 2003 profile, to see what the global phase adds
+  2. formulation 5 (and 2): the front, minimum mean |I_r| at T = 4, 6, 8, 11, 15, 19 s
+  3. formulation 3: robust over mu {0.02, 0.03, 0.04} and the imbalance +-20 %, from the best 19 s design
+  4. validation of every best design beside the 2003 profile on 1024 fresh random starts (seed 9001):
+     ideal motor, at mu 0.03 and 0.04, PI motor, PI motor with 1 Hz setpoints; switch model on 256
+  5. formulation 4: the best 19 s design and the 2003 profile with 2..6 balls of equal total mass
+  6. summary.md, summary.json, best/*.yaml (ready to run), plots (profiles, front, final positions)
+
+One progress line per evaluation, with the stage's and the study's ETA. Needs python3 only.
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+FAMILIES = ["f1_k3", "f1_k4_hold", "f1_k5_sweep", "f1_k6_sweep"]
+FRONT_T = [5, 6, 8, 11, 15, 19]  # plus 4 s: the only profiles of 4 s under the acceleration limit
+MAX_RATE_HZ_S = 314.16 / (2 * math.pi)  # the acceleration limit as a peak f' [Hz/s]: 50
+VALIDATION_SEED = 9001
+REPORT_SEGMENTS = [(25.0, 1.0), (29.5, 10.0), (100.0, 8.0)]
+I_WITHOUT_BALLS = 5.6e-4 * 3.7e-3  # m_I e [kg m]
+
+
+class Study:
+    def __init__(self, args):
+        self.a = args
+        self.out = os.path.abspath(args.out)
+        os.makedirs(self.out, exist_ok=True)
+        self.t0 = time.time()
+        self.evals_total = 0
+        self.evals_done = 0
+        self.eval_time = 0.0
+        self.runs_total = 0
+        self.runs_done = 0
+        self.run_time = 0.0
+
+    # ---- helpers ----------------------------------------------------------------------------
+    def log(self, text):
+        print(text, flush=True)
+
+    def eta_text(self, stage_left_s):
+        # Study ETA: remaining evaluations and validation runs at the rates measured so far.
+        ev_rate = self.eval_time / self.evals_done if self.evals_done else 1.0
+        run_rate = self.run_time / self.runs_done if self.runs_done else 0.004
+        left = (self.evals_total - self.evals_done) * ev_rate + (self.runs_total - self.runs_done) * run_rate
+        return f"stage ETA {fmt_s(stage_left_s)}, study ETA {fmt_s(max(left, stage_left_s))}"
+
+    def optimize(self, name, config_text, evaluations):
+        """Runs abuopt optimize on config_text in OUT/name (resumes), returns result.json."""
+        d = os.path.join(self.out, name)
+        os.makedirs(d, exist_ok=True)
+        cfg = os.path.join(d, "config.yaml")
+        with open(cfg, "w") as f:
+            f.write(config_text)
+        cmd = [self.a.abuopt, "optimize", cfg, "--out", d, "--max-evaluations", str(evaluations), "--threads",
+               str(self.a.threads)]
+        start = last = time.time()
+        done = 0
+        p = subprocess.Popen(["nice", "-n", str(self.a.nice)] + cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             text=True)
+        for line in p.stdout:
+            m = re.match(r"\s*eval\s+(\d+)\s+(.*)", line)
+            if not m:
+                continue
+            done = int(m.group(1))
+            now = time.time()
+            self.evals_done += 1
+            self.eval_time += now - last
+            last = now
+            elapsed = now - start
+            stage_left = elapsed / done * (evaluations - done)
+            best = re.search(r"best=(\S+)", m.group(2))
+            f = re.search(r"\sf=(\S+)", m.group(2))
+            src = "archive" if "[archive]" in line else "computed"
+            self.log(f"[{name}] eval {done}/{evaluations} f={f.group(1) if f else '?'} "
+                     f"best={best.group(1) if best else '?'} ({src}) {self.eta_text(stage_left)}")
+        err = p.stderr.read()
+        p.wait()
+        # Count the stage's budget as done even when the optimiser stopped early (converged).
+        self.evals_total -= max(0, evaluations - done)
+        if p.returncode not in (0, 3):
+            sys.exit(f"abuopt optimize failed on {cfg} (status {p.returncode}):\n{err}")
+        with open(os.path.join(d, "result.json")) as f:
+            return json.load(f)
+
+    def montecarlo(self, name, config_text, runs, seed, extra=()):
+        """abuopt montecarlo, random starts; kept when DIR/summary.json exists. Returns statistics."""
+        d = os.path.join(self.out, "validation", name)
+        summary = os.path.join(d, "summary.json")
+        cfg = os.path.join(d, "config.yaml")
+        # Kept only when it was made from the same config (a changed design is validated again).
+        stamp = config_text + f"# runs {runs} seed {seed} {' '.join(extra)}\n"
+        stale = not os.path.exists(cfg) or read(cfg) not in (stamp, config_text)
+        if stale or not os.path.exists(summary):
+            if os.path.exists(summary):
+                os.remove(summary)
+            os.makedirs(d, exist_ok=True)
+            cfg = os.path.join(d, "config.yaml")
+            with open(cfg, "w") as f:
+                f.write(stamp)
+            start = time.time()
+            cmd = [self.a.abuopt, "montecarlo", cfg, "--design", "random", "--runs", str(runs), "--seed", str(seed),
+                   "--threads", str(self.a.threads), "--out", d] + list(extra)
+            r = subprocess.run(["nice", "-n", str(self.a.nice)] + cmd, capture_output=True, text=True)
+            if r.returncode == 3 and os.path.exists(summary):
+                pass  # every run failed: a counted outcome (ok = 0), not the end of the study
+            elif r.returncode != 0:
+                sys.exit(f"abuopt montecarlo failed on {cfg} (status {r.returncode}):\n{r.stderr}")
+            self.run_time += time.time() - start
+            self.runs_done += runs
+            self.log(f"[validation] {name}: {runs} runs in {time.time() - start:.1f} s; {self.eta_text(0)}")
+        else:
+            self.runs_done += runs
+        return statistics_of(d)
+
+
+def fmt_s(s):
+    s = int(round(s))
+    return f"{s // 60}m{s % 60:02d}s"
+
+
+def read(path):
+    with open(path) as f:
+        return f.read()
+
+
+def set_section_value(text, key, value):
+    """Replaces the first `key: ...` line (any indent) keeping indent and comment."""
+    pat = re.compile(r"^(\s*" + re.escape(key) + r":\s*)([^#\n]*?)(\s*(#.*)?)$", re.M)
+    new, n = pat.subn(lambda m: m.group(1) + str(value) + (("   " + m.group(4)) if m.group(4) else ""), text, count=1)
+    if n != 1:
+        raise ValueError(f"key {key} not found")
+    return new
+
+
+def replace_section(text, section, body):
+    """Replaces a top-level section `section:` (and its indented lines) by body (ends with newline)."""
+    pat = re.compile(r"^" + re.escape(section) + r":.*\n(?:(?:[ #].*)?\n)*?(?=^\S|\Z)", re.M)
+    new, n = pat.subn(body, text, count=1)
+    if n != 1:
+        raise ValueError(f"section {section} not found")
+    return new
+
+
+def set_x0(text, x):
+    """Sets x0 of the free variables f<i>/dt<i> in the design section to the values of dict x."""
+    lines = text.split("\n")
+    out, seg, in_design = [], -1, False
+    for line in lines:
+        if re.match(r"^design:", line):
+            in_design = True
+        elif re.match(r"^\S", line):
+            in_design = False
+        if in_design:
+            if re.match(r"^    - ", line):
+                seg += 1
+            for key, prefix in (("end_frequency_hz", "f"), ("duration_s", "dt")):
+                name = f"{prefix}{seg + 1}"
+                if re.search(key + r":\s*\{", line) and name in x:
+                    line = re.sub(r"x0:\s*[^,}]+", f"x0: {x[name]:.6g}", line)
+        out.append(line)
+    return "\n".join(out)
+
+
+def bounds_of(text):
+    """{name: (lo, hi)} of the free variables."""
+    b, seg, in_design = {}, -1, False
+    for line in text.split("\n"):
+        if re.match(r"^design:", line):
+            in_design = True
+        elif re.match(r"^\S", line):
+            in_design = False
+        if not in_design:
+            continue
+        if re.match(r"^    - ", line):
+            seg += 1
+        for key, prefix in (("end_frequency_hz", "f"), ("duration_s", "dt")):
+            m = re.search(key + r":\s*\{min:\s*([-\d.e]+),\s*max:\s*([-\d.e]+)", line)
+            if m:
+                b[f"{prefix}{seg + 1}"] = (float(m.group(1)), float(m.group(2)))
+    return b
+
+
+def front_x0(x, bnd, T):
+    """A starting point of the k5 family of duration 0.98 T that meets the acceleration limit: the first
+    and last segments get their shortest durations (x 1.05), the middle ones share the rest in the
+    proportions of x."""
+    x0 = dict(x)
+    f1 = min(max(x["f1"], bnd["f1"][0]), 25.0)
+    x0["f1"] = f1
+    dt1 = max(bnd["dt1"][0], 1.05 * 2 * f1 / MAX_RATE_HZ_S)
+    dt5 = max(bnd["dt5"][0], 1.05 * 2 * (100.0 - x["f3"]) / MAX_RATE_HZ_S)
+    rest = 0.98 * T - dt1 - dt5
+    mids = ["dt2", "dt3", "dt4"]
+    total = sum(x[k] for k in mids)
+    x0["dt1"], x0["dt5"] = dt1, dt5
+    for k in mids:
+        lo, hi = bnd[k]
+        x0[k] = min(max(x[k] * rest / total, lo), hi)
+    return x0
+
+
+def global_config(text, runs, evaluations):
+    t = set_section_value(text, "runs", runs)
+    t = set_section_value(t, "max_angular_acceleration_rad_s2", "314.16\n  penalty_weight: 10")
+    return replace_section(t, "optimizer", f"optimizer:\n  algorithm: direct_l\n  max_evaluations: {evaluations}\n")
+
+
+def profile_yaml(profile):
+    s = f"profile:\n  start_frequency_hz: {profile.get('start_frequency_hz', 0)}\n  segments:\n"
+    for g in profile["segments"]:
+        s += f"    - {{end_frequency_hz: {g['end_frequency_hz']:.6g}, duration_s: {g['duration_s']:.6g}}}\n"
+    return s
+
+
+def segments_of(profile):
+    return [(g["end_frequency_hz"], g["duration_s"]) for g in profile["segments"]]
+
+
+def report_profile():
+    return {"start_frequency_hz": 0, "segments": [{"end_frequency_hz": f, "duration_s": d} for f, d in REPORT_SEGMENTS]}
+
+
+def run_config(profile, title, balls=None, motor="  kind: ideal\n", method="event_driven", runs=1024):
+    """A ready-to-run config (abuopt simulate / abuopt montecarlo) of a profile."""
+    ball_lines = ""
+    if balls:
+        ball_lines = "  balls:\n" + "".join(f"    - {{mass_kg: {m:.6g}, diameter_m: {d:.6g}}}\n" for m, d in balls)
+    return (f"# {title}\n"
+            "#   abuopt simulate THIS.yaml --beta0 0.5,3.0\n"
+            "#   abuopt montecarlo THIS.yaml          # 1024 random starts, seed 9001 (the study's validation set)\n"
+            "abu:\n  friction_mu: 0.02\n" + ball_lines + profile_yaml(profile) +
+            f"motor:\n{motor}simulation:\n  method: {method}\n  rtol: 1.0e-6\n"
+            f"montecarlo:\n  design: random\n  runs: {runs}\n  seed: {VALIDATION_SEED}\n  threads: 0\n")
+
+
+def statistics_of(d):
+    """Mean |I_r| and I_r,x with 95 % intervals (normal, on the runs), %MI with the Wilson interval."""
+    with open(os.path.join(d, "summary.json")) as f:
+        s = json.load(f)
+    rows = [r for r in csv.DictReader(open(os.path.join(d, "runs.csv"))) if r["status"] == "ok"]
+    out = {"runs": s["runs"], "ok": s["ok"], "pct_lc": s["pct_lc"], "amp_max_mm": s["max_amplitude_mm"]["max"]}
+    for key, col in (("ir", "ir_magnitude_kgm"), ("irx", "ir_x_kgm")):
+        v = [float(r[col]) / 1e-7 for r in rows]
+        n = len(v)
+        if n == 0:
+            nan = float("nan")
+            out[key] = {"mean": nan, "lo": nan, "hi": nan, "median": nan, "max": nan, "pct_mi": nan, "pct_mi_lo": nan,
+                        "pct_mi_hi": nan}
+            continue
+        mean = sum(v) / n
+        sd = math.sqrt(sum((x - mean) ** 2 for x in v) / (n - 1)) if n > 1 else 0.0
+        half = 1.96 * sd / math.sqrt(n)
+        k = sum(1 for x in v if x * 1e-7 >= I_WITHOUT_BALLS)
+        lo, hi = wilson(k, n)
+        out[key] = {"mean": mean, "lo": mean - half, "hi": mean + half, "median": sorted(v)[n // 2],
+                    "max": max(v), "pct_mi": 100.0 * k / n, "pct_mi_lo": lo, "pct_mi_hi": hi}
+    return out
+
+
+def wilson(k, n, z=1.96):
+    if n == 0:
+        return (float("nan"), float("nan"))
+    p = k / n
+    den = 1 + z * z / n
+    c = (p + z * z / (2 * n)) / den
+    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
+    return (100 * max(0.0, c - h), 100 * min(1.0, c + h))
+
+
+def fmt_ir(s):
+    return f"{s['mean']:.2f} [{s['lo']:.2f}, {s['hi']:.2f}]"
+
+
+def fmt_mi(s):
+    return f"{s['pct_mi']:.2f} [{s['pct_mi_lo']:.2f}, {s['pct_mi_hi']:.2f}]"
+
+
+def main():
+    ap = argparse.ArgumentParser(description="ADOPT startup-profile case study (issue 10)")
+    ap.add_argument("--out", default=os.path.join("results", "startup_study"))
+    ap.add_argument("--abuopt", default=os.path.join(ROOT, "build", "app", "abuopt"))
+    ap.add_argument("--threads", type=int, default=0, help="Monte Carlo threads (0 = all cores)")
+    ap.add_argument("--nice", type=int, default=10)
+    ap.add_argument("--scale", type=float, default=1.0, help="multiplies runs and evaluations (1 = about 30 min on 2 cores)")
+    ap.add_argument("--val-runs", type=int, default=1024, help="fresh random starts per validation (>= 1024 for the report)")
+    ap.add_argument("--skip-balls", action="store_true", help="skip formulation 4 (ball count)")
+    a = ap.parse_args()
+    st = Study(a)
+    sc = a.scale
+    g_evals, p_evals, front_evals, robust_evals = int(120 * sc), int(60 * sc), int(40 * sc), int(30 * sc)
+    g_runs, p_runs, front_runs, robust_runs = int(64 * sc), int(256 * sc), int(128 * sc), int(96 * sc)
+    val_runs, switch_runs = a.val_runs, min(256, a.val_runs)
+    n_designs = len(FAMILIES) + 1 + len(FRONT_T) + 1
+    st.evals_total = len(FAMILIES) * (g_evals + p_evals) + p_evals + len(FRONT_T) * front_evals + robust_evals
+    st.runs_total = (n_designs + 1) * val_runs * 3 + 4 * (val_runs * 2 + switch_runs * 2) + (0 if a.skip_balls else 10 * min(512, val_runs))
+    st.log(f"startup study: {n_designs} designs, about {st.evals_total} evaluations and {st.runs_total} validation "
+           f"runs; output {st.out}")
+    designs = {}  # name -> {"profile", "result", "formulation", "T"}
+
+    # 1. Formulation 1: global then polish, per family.
+    for fam in FAMILIES:
+        base = read(os.path.join(ROOT, "configs", "studies", fam + ".yaml"))
+        base = set_section_value(base, "runs", p_runs)
+        g = st.optimize(fam + "_global", global_config(base, g_runs, g_evals), g_evals)
+        gx = g["best"]["x"]
+        polish = st.optimize(fam + "_polish", set_x0(base, gx), p_evals)
+        designs[fam] = {"result": polish, "global": g, "formulation": 1, "T": 19}
+        if fam == "f1_k3":
+            local = st.optimize("f1_k3_local2003", base, p_evals)
+            designs["f1_k3_local2003"] = {"result": local, "formulation": 1, "T": 19}
+
+    def score(name):
+        b = designs[name]["result"]["best"]
+        return (0 if b["feasible"] else 1, b["objective"])
+
+    best19 = min((n for n in designs if designs[n]["formulation"] == 1), key=score)
+    if not designs[best19]["result"]["best"]["feasible"]:
+        st.log("warning: no formulation-1 design is feasible in sample; best_19s is the least infeasible")
+    st.log(f"best 19 s design in sample: {best19} (objective {designs[best19]['result']['best']['objective']:.3f})")
+
+    # 2. Formulation 5: the front (family k5_sweep), x0 scaled from the best 19 s sweep design.
+    front_base = read(os.path.join(ROOT, "configs", "studies", "f5_front.yaml"))
+    front_base = set_section_value(front_base, "runs", front_runs)
+    sweep_x = designs["f1_k5_sweep"]["result"]["best"]["x"]
+    bnd = bounds_of(front_base)
+    for T in FRONT_T:
+        t = set_section_value(front_base, "max_startup_time_s", T)
+        r = st.optimize(f"f5_T{T}", set_x0(t, front_x0(sweep_x, bnd, T)), front_evals)
+        designs[f"f5_T{T}"] = {"result": r, "formulation": 5, "T": T}
+    # 4 s: an inclined sine peaks at f' = 2 H / dt, so under the limit a profile needs
+    # sum |H_i| / (MAX_RATE / 2) = 100 / 25 = 4 s at least: the one-segment 0 -> 100 Hz in 4 s.
+    designs["f5_T4"] = {"result": {"best": {"objective": float("nan"), "feasible": True, "x": {},
+                                            "profile": {"start_frequency_hz": 0, "segments": [
+                                                {"end_frequency_hz": 100.0, "duration_s": 4.0}]}}},
+                        "formulation": 5, "T": 4}
+
+    # 3. Formulation 3: robust, from the best 19 s design of the sweep family.
+    rb = read(os.path.join(ROOT, "configs", "studies", "f3_robust.yaml"))
+    rb = set_section_value(rb, "runs", robust_runs)
+    r = st.optimize("f3_robust", set_x0(rb, sweep_x), robust_evals)
+    designs["f3_robust"] = {"result": r, "formulation": 3, "T": 19}
+
+    # 4. Validation on fresh starts, beside the 2003 profile on the same starts.
+    profiles = {"report_2003": report_profile()}
+    for n, d in designs.items():
+        profiles[n] = d["result"]["best"]["profile"]
+    best_dir = os.path.join(st.out, "best")
+    os.makedirs(best_dir, exist_ok=True)
+    table = {}
+    # The motor and switch-model checks (the expensive ones) for the designs the document reports in full.
+    heavy = {"report_2003", best19, "f3_robust", "f5_T8"}
+    for n, prof in profiles.items():
+        title = f"startup study design {n}" if n != "report_2003" else "the 2003 report's final profile"
+        cfg = run_config(prof, title)
+        with open(os.path.join(best_dir, n + ".yaml"), "w") as f:
+            f.write(cfg)
+        row = {"T": sum(d for _, d in segments_of(prof)), "profile": prof}
+        row["ideal"] = st.montecarlo(n, cfg, val_runs, VALIDATION_SEED)
+        row["mu0.03"] = st.montecarlo(n + "_mu0.03", cfg, val_runs, VALIDATION_SEED, ["--mu", "0.03"])
+        row["mu0.04"] = st.montecarlo(n + "_mu0.04", cfg, val_runs, VALIDATION_SEED, ["--mu", "0.04"])
+        table[n] = row
+        if n not in heavy:
+            continue
+        row["pi"] = st.montecarlo(n + "_pi", run_config(prof, title, motor="  kind: pi\n"), val_runs, VALIDATION_SEED)
+        row["pi_1hz"] = st.montecarlo(n + "_pi_1hz",
+                                      run_config(prof, title, motor="  kind: pi\n  quantize_setpoint_1hz: true\n"),
+                                      val_runs, VALIDATION_SEED)
+        row["switch"] = st.montecarlo(n + "_switch", run_config(prof, title, method="switch_model"), switch_runs,
+                                      VALIDATION_SEED)
+        row["ideal256"] = st.montecarlo(n + "_ideal256", cfg, switch_runs, VALIDATION_SEED)
+    shutil.copyfile(os.path.join(best_dir, best19 + ".yaml"), os.path.join(best_dir, "best_19s.yaml"))
+
+    # 5. Formulation 4: ball count at equal total ball mass (2.8e-4 kg), same material (d ~ m^(1/3)).
+    balls = {}
+    if not a.skip_balls:
+        for nb in range(2, 7):
+            m = 2.8e-4 / nb
+            dia = 3.0e-3 * (1.4e-4 / m) ** (-1.0 / 3.0)
+            bl = [(m, dia)] * nb
+            for n in ("report_2003", best19):
+                cfg = run_config(profiles[n], f"{n} with {nb} balls", balls=bl)
+                balls[(nb, n)] = st.montecarlo(f"balls{nb}_{n}", cfg, min(512, val_runs), VALIDATION_SEED)
+
+    write_summary(st, designs, table, balls, best19)
+    st.log(f"done in {fmt_s(time.time() - st.t0)}: {os.path.join(st.out, 'summary.md')}")
+
+
+def write_summary(st, designs, table, balls, best19):
+    out = st.out
+    lines = ["# Startup-profile study: validation (1024 fresh random starts, seed 9001; I_r in 1e-7 kg m, 95 % intervals)",
+             "", "| design | T [s] | in-sample mean | mean \\|I_r\\| | %MI \\|I_r\\| | mean I_r,x | %MI I_r,x | "
+             "mu 0.03 mean | mu 0.04 mean | PI mean | PI 1 Hz mean (ok runs) | switch 256 mean | event 256 mean | max amp [mm] |",
+             "|" + "---|" * 14]
+    for n, r in table.items():
+        ins = designs[n]["result"]["best"]["objective"] if n in designs else float("nan")
+        i = r["ideal"]
+        heavy = ("| - | - | - | - " if "pi" not in r else
+                 f"| {fmt_ir(r['pi']['ir'])} | {fmt_ir(r['pi_1hz']['ir'])} ({r['pi_1hz']['ok']}) | "
+                 f"{fmt_ir(r['switch']['ir'])} | {fmt_ir(r['ideal256']['ir'])} ")
+        lines.append(
+            f"| {n} | {r['T']:.2f} | {ins:.2f} | {fmt_ir(i['ir'])} | {fmt_mi(i['ir'])} | {fmt_ir(i['irx'])} | "
+            f"{fmt_mi(i['irx'])} | {fmt_ir(r['mu0.03']['ir'])} | {fmt_ir(r['mu0.04']['ir'])} " + heavy +
+            f"| {i['amp_max_mm']:.3f} |")
+    lines += ["", f"best 19 s design (in sample): {best19}", ""]
+    lines += ["## Profiles", ""]
+    for n, r in table.items():
+        segs = ", ".join(f"{f:.3f} Hz/{d:.3f} s" for f, d in segments_of(r["profile"]))
+        lines.append(f"- {n}: {segs}")
+    lines += ["", "## Global phase against local runs", ""]
+    for n, d in designs.items():
+        if "global" in d:
+            g = d["global"]["best"]
+            lines.append(f"- {n}: global best in sample {g['objective']:.3f} (64 starts, penalised; feasible "
+                         f"{g['feasible']}), polished {d['result']['best']['objective']:.3f} (256 starts), x = "
+                         + ", ".join(f"{k}={v:.4g}" for k, v in sorted(d['result']['best']['x'].items())))
+    if "f1_k3_local2003" in designs:
+        lines.append(f"- f1_k3 polished from the 2003 profile: {designs['f1_k3_local2003']['result']['best']['objective']:.3f}")
+    if balls:
+        lines += ["", "## Ball count (equal total ball mass 2.8e-4 kg; 512 fresh starts)", "",
+                  "| balls | 2003 mean \\|I_r\\| | 2003 %MI | best_19s mean \\|I_r\\| | best_19s %MI |", "|---|---|---|---|---|"]
+        for nb in range(2, 7):
+            a, b = balls[(nb, "report_2003")], balls[(nb, best19)]
+            lines.append(f"| {nb} | {fmt_ir(a['ir'])} | {fmt_mi(a['ir'])} | {fmt_ir(b['ir'])} | {fmt_mi(b['ir'])} |")
+    with open(os.path.join(out, "summary.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    js = {"best19": best19, "table": {n: {k: v for k, v in r.items()} for n, r in table.items()},
+          "balls": {f"{k[0]}_{k[1]}": v for k, v in balls.items()}}
+    with open(os.path.join(out, "summary.json"), "w") as f:
+        json.dump(js, f, indent=1)
+    make_plots(st, table, designs, best19)
+
+
+def settle_frequency(profile, t):
+    t0, f0 = 0.0, profile.get("start_frequency_hz", 0.0)
+    for fe, dt in segments_of(profile):
+        if t <= t0 + dt:
+            phi = 2 * math.pi * (t - t0) / dt
+            return f0 + (fe - f0) / (2 * math.pi) * (phi - math.sin(phi))
+        t0, f0 = t0 + dt, fe
+    return f0
+
+
+def final_positions_plot(st, table, names, gp):
+    """Final ball angles of the validation runs over the equilibrium set at their median settling speed."""
+    out = st.out
+    r_lock = 15.9021  # 1e-7 kg m, docs/equilibrium_sets.md section 4
+    for n in names:
+        runs = os.path.join(out, "validation", n, "runs.csv")
+        rows = [r for r in csv.DictReader(open(runs)) if r["status"] == "ok" and r["settled"] == "1"]
+        if not rows:
+            continue
+        fs = sorted(settle_frequency(table[n]["profile"], float(r["settling_time_s"])) for r in rows)
+        f_med = fs[len(fs) // 2]
+        eq = os.path.join(out, "eqset_" + n)
+        subprocess.run([st.a.abuopt, "eqset", os.path.join(ROOT, "configs", "eqset.yaml"), "--freq", f"{f_med:.3f}",
+                        "--grid", "128", "--out", eq], capture_output=True, text=True)
+        with open(os.path.join(out, f"final_{n}.dat"), "w") as f:
+            for r in rows:
+                b1 = float(r["beta_final_1"]) % (2 * math.pi)
+                b2 = float(r["beta_final_2"]) % (2 * math.pi)
+                f.write(f"{b1:.5f},{b2:.5f},{float(r['ir_magnitude_kgm']) / 1e-7:.4f}\n")
+        below = sum(1 for r in rows if float(r["ir_magnitude_kgm"]) / 1e-7 < r_lock) / len(rows) * 100
+        body = (f"set title '{n}: final angles of {len(rows)} fresh starts over the set at {f_med:.2f} Hz\\n"
+                f"(the median settling speed); {below:.0f} % below r_lock = 15.9e-7'\n"
+                "set xlabel 'beta_1 [rad]'; set ylabel 'beta_2 [rad]'; set size square; set xrange [0:6.2832]; "
+                "set yrange [0:6.2832]\nset datafile separator ','\nset cblabel 'final |I_r| [1e-7 kg m]'\n"
+                "set palette defined (0 'blue', 15.9 'green', 20.7 'orange', 35 'red'); set cbrange [0:35]\n"
+                f"plot '{os.path.basename(eq)}/equilibrium_set.csv' every ::1 using 1:($4 > 0 ? $2 : 1/0) "
+                "with points pt 5 ps 0.35 lc rgb '#d9ead3' title 'in the set', "
+                f"'final_{n}.dat' using 1:2:3 with points pt 7 ps 0.5 palette title 'final angles', "
+                "'+' using (2.2698):(4.0134) with points pt 3 ps 2 lc rgb 'black' title 'balancing points', "
+                "'+' using (4.0134):(2.2698) with points pt 3 ps 2 lc rgb 'black' notitle")
+        p = os.path.join(out, f"final_{n}.gp")
+        with open(p, "w") as f:
+            f.write(f"set terminal pngcairo size 900,850 noenhanced\nset output 'final_{n}.png'\n{body.replace(chr(39) + '+' + chr(39), chr(39) + '+' + chr(39))}\n")
+        if gp:
+            subprocess.run([gp, os.path.basename(p)], cwd=out, capture_output=True)
+
+
+def make_plots(st, table, designs, best19):
+    out = st.out
+    gp = shutil.which("gnuplot")
+    final_positions_plot(st, table, ["report_2003", best19], gp)
+    # Profiles f(t), sampled.
+    with open(os.path.join(out, "profiles.dat"), "w") as f:
+        for n, r in table.items():
+            f.write(f"# {n}\n")
+            t0, f0 = 0.0, 0.0
+            for fe, dt in segments_of(r["profile"]):
+                for k in range(41):
+                    phi = 2 * math.pi * k / 40
+                    f.write(f"{t0 + dt * k / 40:.4f} {f0 + (fe - f0) / (2 * math.pi) * (phi - math.sin(phi)):.4f}\n")
+                t0, f0 = t0 + dt, fe
+            f.write("\n\n")
+    names = list(table)
+    with open(os.path.join(out, "front.dat"), "w") as f:
+        for n, r in table.items():
+            i = r["ideal"]["ir"]
+            f.write(f"{r['T']:.3f} {i['mean']:.4f} {i['lo']:.4f} {i['hi']:.4f} {i['pct_mi']:.3f} \"{n}\"\n")
+    scripts = {
+        "profiles.png": "set title 'startup profiles: the study designs against the 2003 profile'\n"
+                        "set xlabel 'time [s]'; set ylabel 'frequency [Hz]'; set yrange [20:35]; set key outside right\n"
+                        "plot " + ", ".join(f"'profiles.dat' index {k} with lines lw {3 if n == 'report_2003' else 1.5} "
+                                           f"title '{n}'" for k, n in enumerate(names)),
+        "profiles_full.png": "set title 'startup profiles (0 to 100 Hz)'\nset xlabel 'time [s]'; set ylabel 'frequency [Hz]'; set key outside right\n"
+                             "plot " + ", ".join(f"'profiles.dat' index {k} with lines title '{n}'" for k, n in enumerate(names)),
+        "front.png": "set title 'startup time against mean |I_r| (1024 fresh starts, 95 % intervals)'\n"
+                     "set xlabel 'startup time [s]'; set ylabel 'mean |I_r| [1e-7 kg m]'; set y2label '%MI(|I_r|) [%]'\n"
+                     "set ytics nomirror; set y2tics; set key top right; set xrange [3:20]; set yrange [0:40]\n"
+                     "plot 'front.dat' using 1:2:3:4 with yerrorbars pt 7 title 'mean |I_r|', "
+                     "'front.dat' using 1:5 axes x1y2 with points pt 6 ps 1.5 title '%MI (right axis)', "
+                     "'front.dat' using 1:($1 < 16 || strcol(6) eq 'report_2003' || strcol(6) eq 'f1_k4_hold' ? $2 : 1/0):6 "
+                     "with labels offset 0,1.2 font ',8' notitle, 7.0 with lines dt 2 title 'goal 7.0', "
+                     "11.48 with lines dt 3 title 'pair floor 11.48 (balls together)'",
+    }
+    for png, body in scripts.items():
+        p = os.path.join(out, png.replace(".png", ".gp"))
+        with open(p, "w") as f:
+            f.write(f"set terminal pngcairo size 1000,650 noenhanced\nset output '{png}'\nset grid\n{body}\n")
+        if gp:
+            subprocess.run([gp, os.path.basename(p)], cwd=out, capture_output=True)
+
+
+if __name__ == "__main__":
+    main()
