@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "abuopt/core/ball_contact.hpp"
 #include "abuopt/core/simulation_config.hpp"
 #include "study_text.hpp"
 
@@ -44,6 +45,22 @@ std::string tables_csv_header() {
          "settling_max_s,amplitude_max_mm,wall_time_s";
 }
 
+std::size_t count_overlapping_final_states(const AbuParameters& p, const MonteCarloResult& r) {
+  std::size_t n = 0;
+  for (const MonteCarloSample& smp : r.samples)
+    if (smp.outcome.beta_final.size() == p.balls.size() && p.balls.size() >= 2 &&
+        min_contact_clearance(p, smp.outcome.beta_final) < -kOverlapTolerance_rad)
+      ++n;
+  return n;
+}
+
+std::string tables_contact_csv_header() { return tables_csv_header() + ",ball_contact,overlapping_without,overlapping_with"; }
+
+std::string tables_contact_csv_line(const ContactRow& r, BallContact contact) {
+  return tables_csv_line(r.summary) + "," + to_string(contact) + "," + std::to_string(r.overlapping_without) + "," +
+         std::to_string(r.overlapping_with);
+}
+
 std::string tables_csv_line(const CaseSummary& s) {
   const auto inside = reference_pct_mi_inside(s);
   std::ostringstream os;
@@ -72,6 +89,39 @@ std::size_t table_runs(const TableResult& t) {
   return runs;
 }
 
+std::string contact_name(const TableResult& t) {
+  return t.table.contact_variant ? to_string(*t.table.contact_variant) : std::string("none");
+}
+
+// What contact changes, in one sentence per table: every case's mean I_r,x and %MI without -> with.
+std::string contact_sentence(const TableResult& t) {
+  if (t.contact_rows.empty()) return "";
+  std::size_t over = 0, over_with = 0, runs = 0, worse_mean = 0, worse_mi = 0;
+  for (std::size_t k = 0; k < t.contact_rows.size() && k < t.rows.size(); ++k) {
+    const ContactRow& c = t.contact_rows[k];
+    over += c.overlapping_without;
+    over_with += c.overlapping_with;
+    runs += t.rows[k].runs;
+    if (c.summary.mean_x > t.rows[k].mean_x) ++worse_mean;
+    if (c.summary.pct_mi_x > t.rows[k].pct_mi_x) ++worse_mi;
+  }
+  std::ostringstream os;
+  os << "What ball contact (" << contact_name(t) << ") changes: without it " << over << " of " << runs
+     << " final states overlap (" << num(runs ? 100.0 * over / runs : 0.0, 1) << " %), with it " << over_with
+     << "; mean I_r,x is higher with contact in " << worse_mean << " of " << t.contact_rows.size() << " cases and %MI in "
+     << worse_mi << " of " << t.contact_rows.size();
+  for (const Conclusion& k : t.table.conclusions) {
+    if (k.check != ConclusionCheck::BeatsAll) continue;
+    std::vector<CaseSummary> rows;
+    for (const ContactRow& c : t.contact_rows) rows.push_back(c.summary);
+    ReproductionTable tt = t.table;
+    tt.conclusions = {k};
+    for (const Verdict& v : check_conclusions(tt, rows)) os << "; with contact, conclusion (" << k.id << ") is " << to_string(v.outcome);
+  }
+  os << ".";
+  return os.str();
+}
+
 }  // namespace
 
 std::string format_table_text(const TableResult& t) {
@@ -97,6 +147,24 @@ std::string format_table_text(const TableResult& t) {
   }
   for (const CaseSummary& s : t.rows)
     if (!s.reference.note.empty()) os << "  note (" << s.label << "): " << s.reference.note << "\n";
+  if (!t.contact_rows.empty()) {
+    os << "  the same starts with ball contact (" << contact_name(t)
+       << "); overlap = final states whose balls overlap, without / with contact:\n";
+    std::snprintf(line, sizeof line, "  %-20s %5s  %-22s %-26s %-9s %-20s %-11s %s\n", "case", "runs",
+                  "mean I_r,x (contact)", "%MI (contact) [95% CI]", "|I_r| (c)", "|I_r| %MI (c) [CI]", "overlap", "wall");
+    os << line;
+    for (const ContactRow& r : t.contact_rows) {
+      const CaseSummary& s = r.summary;
+      const std::string mag_mi = num(s.pct_mi_mag, 1) + " [" + num(s.ci_mag[0], 1) + ", " + num(s.ci_mag[1], 1) + "]";
+      const std::string ov = std::to_string(r.overlapping_without) + " / " + std::to_string(r.overlapping_with);
+      std::snprintf(line, sizeof line, "  %-20s %5zu  %-22s %-26s %-9s %-20s %-11s %.1f s%s\n", s.label.c_str(), s.runs,
+                    (num(s.mean_x, 2) + " +- " + num(s.sem_x, 2)).c_str(), mi_text(s).c_str(), num(s.mean_mag, 2).c_str(),
+                    mag_mi.c_str(), ov.c_str(), s.wall_time_s,
+                    s.failed ? (" (" + std::to_string(s.failed) + " failed)").c_str() : "");
+      os << line;
+    }
+    os << "  " << contact_sentence(t) << "\n";
+  }
   if (!t.table.expectation.empty()) os << "  expected (report): " << t.table.expectation << "\n";
   for (const Verdict& v : t.verdicts) os << "  " << v.one_line() << "\n";
   return os.str();
@@ -123,6 +191,25 @@ std::string format_table_markdown(const TableResult& t) {
        << " | " << num(s.wall_time_s, 1) << " |\n";
   }
   os << "\n";
+  if (!t.contact_rows.empty()) {
+    os << "The same cases and starts with `ball_contact: " << contact_name(t)
+       << "` (docs/model.md 11; a grid is mapped onto the feasible set, 11.6). Overlap: final states whose balls "
+          "overlap, without / with contact.\n\n"
+       << "| case | runs | mean I_r,x | mean I_r,x (contact) | %MI (95 % CI) | %MI (contact) (95 % CI) | "
+          "mean \\|I_r\\| (contact) | %MI \\|I_r\\| (contact) (95 % CI) | overlap | failed (contact) | wall (contact) [s] |\n"
+       << "|---|---:|---:|---:|---|---|---:|---|---:|---:|---:|\n";
+    for (std::size_t k = 0; k < t.contact_rows.size() && k < t.rows.size(); ++k) {
+      const CaseSummary& a = t.rows[k];
+      const CaseSummary& c = t.contact_rows[k].summary;
+      os << "| " << md_escape(a.label) << " | " << c.runs << " | " << num(a.mean_x, 2) << " | " << num(c.mean_x, 2)
+         << " | " << num(a.pct_mi_x, 2) << " (" << num(a.ci_x[0], 1) << " .. " << num(a.ci_x[1], 1) << ") | "
+         << num(c.pct_mi_x, 2) << " (" << num(c.ci_x[0], 1) << " .. " << num(c.ci_x[1], 1) << ") | "
+         << num(c.mean_mag, 2) << " | " << num(c.pct_mi_mag, 2) << " (" << num(c.ci_mag[0], 1) << " .. "
+         << num(c.ci_mag[1], 1) << ") | " << t.contact_rows[k].overlapping_without << " / "
+         << t.contact_rows[k].overlapping_with << " | " << c.failed << " | " << num(c.wall_time_s, 1) << " |\n";
+    }
+    os << "\n" << contact_sentence(t) << "\n\n";
+  }
   for (const CaseSummary& s : t.rows)
     if (!s.reference.note.empty()) os << "Note (" << s.label << "): " << s.reference.note << ".\n\n";
   for (const Verdict& v : t.verdicts) os << "- " << md_escape(v.one_line()) << "\n";
@@ -182,6 +269,8 @@ std::string format_report_markdown(const ReproductionReport& r, const Reproducti
     os << ", " << t.table.cases.front().study.runs << " runs per case, " << t.table.cases.size() << (t.table.cases.size() == 1 ? " case\n" : " cases\n");
   }
   os << "\nPer-run data: `runs/<table>/<case>.csv` (one line per run); all rows: `tables.csv`.\n";
+  if (!r.tables_contact_csv_path.empty())
+    os << "With ball contact: `runs/<table>/<case>_contact_<model>.csv`; rows: `tables_contact.csv`.\n";
   return os.str();
 }
 

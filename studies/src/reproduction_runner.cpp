@@ -36,6 +36,7 @@ ReproductionReport run_reproduction(const std::vector<ReproductionTable>& tables
   // every finished case, and a failed write never leaves a truncated file under the name.
   std::string tables_csv = tables_csv_header() + "\n";
   write_text_file(report.tables_csv_path, tables_csv);
+  std::string tables_contact_csv;
 
   ThreadPoolRunner runner(opt.threads);
   report.concurrency = runner.concurrency();
@@ -72,6 +73,31 @@ ReproductionReport run_reproduction(const std::vector<ReproductionTable>& tables
       line += opt_num(c.reference.pct_mi, 2) + (s.failed ? ", " + std::to_string(s.failed) + " failed" : "");
       line += "); total " + num(elapsed, 0) + " s";
       log(line);
+      if (table.contact_variant) {
+        MonteCarloStudy cs = c.study;
+        cs.setup.abu.ball_contact = *table.contact_variant;
+        MonteCarloResult cr = run_monte_carlo(cs, runner);
+        {
+          std::ostringstream f;
+          write_runs_csv(f, cr.samples);
+          write_text_file(run_dir / (c.id + "_contact_" + to_string(*table.contact_variant) + ".csv"), f.str());
+        }
+        ContactRow row;
+        row.summary = summarize_case(table, c, cr);
+        row.overlapping_without = count_overlapping_final_states(c.study.setup.abu, result);
+        row.overlapping_with = count_overlapping_final_states(cs.setup.abu, cr);
+        if (report.tables_contact_csv_path.empty()) {
+          report.tables_contact_csv_path = (out / "tables_contact.csv").string();
+          tables_contact_csv = tables_contact_csv_header() + "\n";
+        }
+        tables_contact_csv += tables_contact_csv_line(row, *table.contact_variant) + "\n";
+        write_text_file(report.tables_contact_csv_path, tables_contact_csv);
+        std::string cl = "  with ball_contact " + to_string(*table.contact_variant) + ": " + num(row.summary.wall_time_s, 1);
+        cl += " s (mean I_r,x " + num(row.summary.mean_x, 2) + ", %MI " + num(row.summary.pct_mi_x, 2) + ", overlapping final states ";
+        cl += std::to_string(row.overlapping_with) + " vs " + std::to_string(row.overlapping_without) + " without contact)";
+        log(cl);
+        tr.contact_rows.push_back(std::move(row));
+      }
       tr.rows.push_back(std::move(s));
       tr.results.push_back(std::move(result));
     }

@@ -67,6 +67,13 @@ ReproductionTable read_table(YamlReader& root, const std::string& name) {
     t.parameter_unit = par.get_string_or("unit", "");
     par.finish();
   }
+  if (tr.has("contact_variant")) {
+    const std::string v = tr.get_string("contact_variant");
+    for (const auto& [e, name] : kBallContactNames)
+      if (name == v) t.contact_variant = e;
+    if (!t.contact_variant || *t.contact_variant == BallContact::None)
+      throw ConfigError(tr.key_path("contact_variant"), v, "must be a ball contact other than the report's model: hard");
+  }
   for (YamlReader& c : tr.children("conclusions")) {
     Conclusion k;
     k.id = c.get_string("id");

@@ -55,6 +55,12 @@ TEST(ReproduceCli, Tables44AndFinalWith16Runs) {
   EXPECT_EQ(count_lines(kOut + "/tables.csv"), 1u + 8u);
   EXPECT_EQ(count_lines(kOut + "/runs/4.4/three_step.csv"), 1u + 16u);
   EXPECT_EQ(count_lines(kOut + "/runs/final/final.csv"), 1u + 16u);
+  // Both tables carry contact_variant: hard, an extra column set of the same starts with contact.
+  EXPECT_NE(r.output.find("mean I_r,x (contact)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("What ball contact (hard) changes"), std::string::npos) << r.output;
+  EXPECT_EQ(count_lines(kOut + "/tables_contact.csv"), 1u + 8u);
+  EXPECT_EQ(count_lines(kOut + "/runs/4.4/three_step_contact_hard.csv"), 1u + 16u);
+  EXPECT_EQ(count_lines(kOut + "/runs/final/final_contact_hard.csv"), 1u + 16u);
   const std::string md = read_all(kOut + "/report.md");
   EXPECT_NE(md.find("| one-step, 19 s | 16 |"), std::string::npos);
   EXPECT_NE(md.find("wall time:"), std::string::npos);

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/core/ball_contact.hpp"
 
 namespace abuopt {
 namespace {
@@ -466,6 +467,122 @@ TEST(ReproductionRun, WritesEveryFileAsCasesFinish) {
   EXPECT_EQ(r.verdicts().size(), 1u);
   const std::string txt = format_table_text(r.tables[0]);
   EXPECT_NE(txt.find("dt = 0.2 s"), std::string::npos);
+}
+
+// --- contact_variant: the same cases with hard ball contact as an extra column set ----------------
+
+TEST(ReproductionContact, ShippedTablesAskForIt) {
+  EXPECT_EQ(table("4.4").contact_variant, BallContact::Hard);
+  EXPECT_EQ(table("final").contact_variant, BallContact::Hard);
+  EXPECT_FALSE(table("4.1").contact_variant.has_value());
+  for (const ReproductionCase& c : table("4.4").cases) EXPECT_EQ(c.study.setup.abu.ball_contact, BallContact::None);
+}
+
+TEST(ReproductionContact, VariantMustDifferFromTheReportsModel) {
+  std::string y = kTiny;
+  const std::string key = "  conclusions:";
+  ASSERT_NE(y.find(key), std::string::npos);
+  std::string bad = y;
+  bad.replace(bad.find(key), key.size(), "  contact_variant: none\n" + key);
+  try {
+    read_reproduction_table_string(bad, "tiny.yaml");
+    FAIL() << "contact_variant: none accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("contact_variant"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("hard"), std::string::npos) << e.what();
+  }
+  std::string good = y;
+  good.replace(good.find(key), key.size(), "  contact_variant: hard\n" + key);
+  EXPECT_EQ(read_reproduction_table_string(good, "tiny.yaml").contact_variant, BallContact::Hard);
+}
+
+TEST(ReproductionContact, CountsOverlappingFinalStates) {
+  AbuParameters p = table("4.4").cases.front().study.setup.abu;
+  const double delta = contact_spacing(p, 0, 1);  // 0.2617 rad for two 3 mm balls on 11.5 mm
+  MonteCarloResult r;
+  for (double gap : {0.0, 0.5 * delta, delta, 2.0 * delta, 6.0}) {
+    MonteCarloSample s;
+    s.outcome.beta_final = {1.0, 1.0 + gap};
+    r.samples.push_back(s);
+  }
+  // 0 and delta/2 overlap; delta touches; 2 delta is apart; 6 rad is 2 pi - 6 = 0.28 > delta around the back.
+  EXPECT_EQ(count_overlapping_final_states(p, r), 2u);
+}
+
+// Table 4.4 on a 6 x 6 grid, two cases, with and without the variant: the contact columns exist,
+// no contact run ends overlapping, and every no-contact number and file is the same as without it.
+TEST(ReproductionContact, ExtraColumnsAndNoContactUnchanged) {
+  ReproductionTable t = table("4.4");
+  t.cases.erase(std::remove_if(t.cases.begin(), t.cases.end(),
+                               [](const ReproductionCase& c) { return c.id != "three_step" && c.id != "one_step_2"; }),
+                t.cases.end());
+  ASSERT_EQ(t.cases.size(), 2u);
+  std::vector<ReproductionTable> with{t};
+  override_runs(with, 36);
+  std::vector<ReproductionTable> without = with;
+  without[0].contact_variant.reset();
+  auto run = [](const std::vector<ReproductionTable>& tables, const std::string& name) {
+    ReproductionOptions opt;
+    opt.out_dir = std::string(ABUOPT_BINARY_DIR) + "/" + name;
+    std::filesystem::remove_all(opt.out_dir);
+    opt.threads = 2;
+    opt.plots = false;
+    return run_reproduction(tables, opt);
+  };
+  const ReproductionReport a = run(with, "reproduction_contact_on");
+  const ReproductionReport b = run(without, "reproduction_contact_off");
+  const TableResult& ta = a.tables.at(0);
+  const TableResult& tb = b.tables.at(0);
+  ASSERT_EQ(ta.contact_rows.size(), 2u);
+  EXPECT_TRUE(tb.contact_rows.empty());
+  std::size_t overlapping_without = 0;
+  for (const ContactRow& r : ta.contact_rows) {
+    EXPECT_EQ(r.summary.runs, 36u);
+    EXPECT_EQ(r.summary.failed, 0u);
+    EXPECT_EQ(r.overlapping_with, 0u) << r.summary.label;
+    overlapping_without += r.overlapping_without;
+  }
+  EXPECT_GT(overlapping_without, 0u) << "the grid without contact should end some runs overlapping";
+  // The no-contact columns: identical numbers (wall time aside) and identical per-run files.
+  for (std::size_t k = 0; k < 2; ++k) {
+    CaseSummary x = ta.rows[k], y = tb.rows[k];
+    x.wall_time_s = y.wall_time_s = 0;
+    EXPECT_EQ(tables_csv_line(x), tables_csv_line(y));
+    auto slurp = [](const std::string& f) {
+      std::ifstream in(f);
+      return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    };
+    const std::string id = t.cases[k].id;
+    const std::string on = std::string(ABUOPT_BINARY_DIR) + "/reproduction_contact_on/runs/4.4/";
+    const std::string off = std::string(ABUOPT_BINARY_DIR) + "/reproduction_contact_off/runs/4.4/";
+    EXPECT_EQ(slurp(on + id + ".csv"), slurp(off + id + ".csv"));
+    EXPECT_TRUE(std::filesystem::exists(on + id + "_contact_hard.csv"));
+    EXPECT_FALSE(std::filesystem::exists(off + id + "_contact_hard.csv"));
+  }
+  ASSERT_EQ(ta.verdicts.size(), tb.verdicts.size());
+  for (std::size_t k = 0; k < ta.verdicts.size(); ++k) EXPECT_EQ(ta.verdicts[k].outcome, tb.verdicts[k].outcome);
+  // The column set in the terminal table, the Markdown and tables_contact.csv.
+  const std::string txt = format_table_text(ta);
+  EXPECT_NE(txt.find("mean I_r,x (contact)"), std::string::npos) << txt;
+  EXPECT_NE(txt.find("%MI (contact)"), std::string::npos) << txt;
+  EXPECT_NE(txt.find("What ball contact (hard) changes"), std::string::npos) << txt;
+  EXPECT_EQ(format_table_text(tb).find("(contact)"), std::string::npos);
+  const std::string md = format_table_markdown(ta);
+  EXPECT_NE(md.find("| mean I_r,x (contact) |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| %MI (contact) (95 % CI) |"), std::string::npos) << md;
+  ASSERT_FALSE(a.tables_contact_csv_path.empty());
+  EXPECT_TRUE(b.tables_contact_csv_path.empty());
+  std::ifstream csv(a.tables_contact_csv_path);
+  std::string header, line;
+  std::getline(csv, header);
+  EXPECT_EQ(header, tables_contact_csv_header());
+  int lines = 0;
+  while (std::getline(csv, line)) {
+    ASSERT_LT(lines, 2);
+    const ContactRow& r = ta.contact_rows[lines++];
+    EXPECT_EQ(line, tables_csv_line(r.summary) + ",hard," + std::to_string(r.overlapping_without) + ",0");
+  }
+  EXPECT_EQ(lines, 2);
 }
 
 }  // namespace

@@ -14,9 +14,22 @@ namespace abuopt {
 
 // --- Running and reporting ----------------------------------------------------------------------
 
+// One case run again with the table's contact_variant (same starts, mapped onto the feasible set).
+struct ContactRow {
+  CaseSummary summary;                  // the case with contact on
+  std::size_t overlapping_without = 0;  // final states of the no-contact runs that overlap
+  std::size_t overlapping_with = 0;     // the same with contact on (the model says 0)
+};
+
+// A final state overlaps when min_contact_clearance < -kOverlapTolerance_rad (the simulator closes
+// rounding-level negative gaps; docs/model.md 11.5 measured >= -6e-15 rad).
+inline constexpr double kOverlapTolerance_rad = 1e-9;
+std::size_t count_overlapping_final_states(const AbuParameters& p, const MonteCarloResult& r);
+
 struct TableResult {
   ReproductionTable table;
   std::vector<CaseSummary> rows;            // one per case, in case order
+  std::vector<ContactRow> contact_rows;     // one per case when table.contact_variant is set
   std::vector<MonteCarloResult> results;    // the samples (for the plots)
   std::vector<Verdict> verdicts;
   double wall_time_s = 0;
@@ -46,6 +59,7 @@ struct ReproductionReport {
   double wall_time_s = 0;
   std::size_t concurrency = 1;
   std::string markdown_path, tables_csv_path;
+  std::string tables_contact_csv_path;  // empty when no table has a contact_variant
   std::vector<Verdict> verdicts() const;  // of every table, in order
 };
 
@@ -59,5 +73,9 @@ std::string format_report_markdown(const ReproductionReport& r, const Reproducti
 // tables.csv: the header line, and one line per case.
 std::string tables_csv_header();
 std::string tables_csv_line(const CaseSummary& s);
+// tables_contact.csv (tables with a contact_variant): tables.csv's columns, then the contact model
+// and the overlapping final states without and with contact.
+std::string tables_contact_csv_header();
+std::string tables_contact_csv_line(const ContactRow& r, BallContact contact);
 
 }  // namespace abuopt

@@ -18,6 +18,7 @@
 //       - {id: b, check: pct_mi_decreases_with_value, claim: "..."}
 //       - {id: a, check: beats_all, case: three_step, claim: "..."}
 //       - {id: c, check: worsens_with_value, claim: "..."}
+//     contact_variant: hard              # optional: also run every case with this ball contact
 //     plots:                             # optional; kinds below
 //       - {kind: trend | final_positions | settling_histogram | equilibrium_overlay,
 //          name: file_stem, cases: [case ids]}
@@ -98,6 +99,10 @@ struct ReproductionTable {
   std::vector<Conclusion> conclusions;
   std::vector<PlotRequest> plots;
   std::vector<ReproductionCase> cases;
+  // table.contact_variant (optional, e.g. `hard`): every case is run a second time with
+  // abu.ball_contact set to this (same starts; docs/model.md 11.6 maps a grid onto the feasible
+  // set), and reported as an extra column set beside the case's own columns.
+  std::optional<BallContact> contact_variant;
   std::string file;    // where it was read from (or the name given to the string reader)
 
   const ReproductionCase* find_case(const std::string& case_id) const;  // nullptr if absent
