@@ -137,7 +137,9 @@ int run_single(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig&
     for (std::size_t i = 0; i < n; ++i)
       for (std::size_t j = 0; j < n; ++j) {
         const std::size_t k = g.index(i, j);
-        f << g.beta(i) << "," << g.beta(j) << "," << g.amplitude_mm[k] << "," << int(g.in_set[k]);
+        // With hard contact in_set is -1 where the balls overlap (excluded: not a configuration).
+        const int in = !g.excluded.empty() && g.excluded[k] ? -1 : int(g.in_set[k]);
+        f << g.beta(i) << "," << g.beta(j) << "," << g.amplitude_mm[k] << "," << in;
         for (std::size_t b = 0; b < nb; ++b) f << "," << g.margins[k * nb + b];
         f << "\n";
       }
@@ -149,6 +151,26 @@ int run_single(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig&
       in_min = std::min(in_min, g.amplitude_mm[k]);
       in_max = std::max(in_max, g.amplitude_mm[k]);
     }
+
+  // Hard contact, two balls: the touching configurations (a line of zero area the grid misses),
+  // sampled on the contact lines beta_2 = beta_1 +- delta (docs/equilibrium_sets.md section 5).
+  std::optional<EquilibriumSet::ContactLine> line;
+  std::size_t excluded = 0;
+  for (char e : g.excluded) excluded += e ? 1 : 0;
+  fs::path line_csv;
+  if (!g.excluded.empty() && nb == 2) {
+    line = set.contact_line(freq, n);
+    line_csv = dir / "contact_line.csv";
+    AtomicFile f(line_csv);
+    f << "beta1_rad,beta2_rad,side,in_set\n" << std::setprecision(10);
+    for (int side = 0; side < 2; ++side)
+      for (std::size_t k = 0; k < n; ++k) {
+        const double b1 = 2 * M_PI * static_cast<double>(k) / static_cast<double>(n);
+        f << b1 << "," << b1 + (side == 0 ? line->spacing_rad : -line->spacing_rad) << ","
+          << (side == 0 ? "ahead" : "behind") << "," << int(line->in_set[side][k]) << "\n";
+      }
+    f.commit();
+  }
 
   GridPlot plot;
   plot.csv_path = csv.string();
@@ -164,6 +186,11 @@ int run_single(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig&
   plot.cb_min = 0;
   plot.cb_max = 1;
   plot.cb_tics = "('outside' 0, 'in set' 1)";
+  if (!g.excluded.empty()) {
+    plot.palette = "defined (-1 '#999999', -0.33 '#999999', -0.33 '#f4cccc', 0.33 '#f4cccc', 0.33 '#b6d7a8', 1 '#b6d7a8')";
+    plot.cb_min = -1;
+    plot.cb_tics = "('overlap' -1, 'outside' 0, 'in set' 1)";
+  }
   plot.contour_column = 3;
   plot.contour_levels = 8;
   plot.contour_title = "steady amplitude [mm]";
@@ -184,6 +211,13 @@ int run_single(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig&
     else
       j["amplitude_in_set_mm"] = nullptr;
     j["csv"] = csv.string();
+    if (!g.excluded.empty()) {
+      j["ball_contact"] = "hard";
+      j["excluded_overlapping"] = excluded;
+      if (line)
+        j["contact_line"] = {{"spacing_rad", line->spacing_rad}, {"samples", n}, {"coverage_ahead", line->coverage(0)},
+                             {"coverage_behind", line->coverage(1)}, {"csv", line_csv.string()}};
+    }
     j["png"] = plot.png_path;
     j["plot"] = {{"status", to_string(ps.state)}, {"message", ps.message}, {"script", ps.script_path}};
     std::cout << j.dump(2) << "\n";
@@ -192,9 +226,20 @@ int run_single(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig&
     std::cout << "frequency:         " << freq << " Hz (W = " << set.speed_ratio(freq) << ", natural frequency "
               << set.natural_frequency_hz() << " Hz), mu = " << set.mu() << "\n";
     std::cout << "coverage:          " << g.coverage() << " of the " << n << " x " << n << " grid over (beta_1, beta_2)"
-              << (set.full_coverage_margin(freq) >= 0 ? " (closed form: the whole plane)" : "") << "\n";
+              << (set.full_coverage_margin(freq) >= 0
+                      ? (g.excluded.empty() ? " (closed form: the whole plane)"
+                                            : " (closed form: every configuration whose balls do not overlap)")
+                      : "")
+              << "\n";
     std::cout << "amplitude [mm]:    " << g.min_amplitude_mm() << " .. " << g.max_amplitude_mm() << " (all points)";
     if (in_min <= in_max) std::cout << ", " << in_min << " .. " << in_max << " (in the set)";
+    if (!g.excluded.empty()) {
+      std::cout << "\ncontact (hard):    " << excluded << " grid points have overlapping balls (excluded, in_set = -1)";
+      if (line)
+        std::cout << "\ncontact line:      touching (|beta_1 - beta_2| = " << line->spacing_rad << " rad): "
+                  << line->coverage(0) << " (ball 2 ahead) and " << line->coverage(1) << " (behind) of " << n
+                  << " points each in the set; " << line_csv.string();
+    }
     std::cout << "\ncsv:               " << csv.string() << "\n";
     std::cout << "plot:              " << (ps.ran() ? plot.png_path : ps.message) << "\n";
   }

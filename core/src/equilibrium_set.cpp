@@ -1,5 +1,7 @@
 #include "abuopt/core/equilibrium_set.hpp"
 
+#include "abuopt/core/ball_contact.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -12,6 +14,9 @@ namespace abuopt {
 namespace {
 
 constexpr double kTwoPi = 2.0 * M_PI;
+// Hard contact: a pair closer than its least spacing by more than this overlaps; within it, it
+// touches (docs/equilibrium_sets.md section 5).
+constexpr double kTouchTolerance_rad = 1e-9;
 
 void require_positive_frequency(double f, const char* what) {
   if (!(f > 0) || !std::isfinite(f))
@@ -65,7 +70,7 @@ std::pair<double, double> EquilibriumSet::steady_state(double frequency_hz, cons
 }
 
 bool EquilibriumSet::evaluate_point(double W, const double* beta, std::vector<double>& state, ModelForces& f,
-                                    double* margins_out, double& amp_mm) const {
+                                    double* margins_out, double& amp_mm, bool* overlapping, bool* touching) const {
   const std::size_t n = n_balls();
   const double W2 = W * W;
   double Cx = nd_.mbar_I * nd_.ebar, Cy = 0;
@@ -89,6 +94,52 @@ bool EquilibriumSet::evaluate_point(double W, const double* beta, std::vector<do
   for (std::size_t i = 0; i < n; ++i) state[lay.beta(i)] = beta[i];
   static thread_local std::vector<BallMode> modes;
   modes.assign(n, BallMode::Stick);
+  if (params_.ball_contact == BallContact::Hard && n >= 2) {
+    // Section 5: overlapping is no configuration; touching balls are one stuck cluster whose
+    // blocks must not break away (docs/model.md 11.4: the margins of its prefixes and suffixes).
+    const std::vector<double> b(beta, beta + n);
+    const ContactGeometry geo = ContactGeometry::from(params_, b);
+    std::vector<double> unwrapped(n);
+    for (std::size_t k = 0; k < n; ++k) unwrapped[k] = b[geo.order[k]] - std::floor(b[geo.order[k]] / kTwoPi) * kTwoPi;
+    bool over = false, touch = false;
+    std::vector<char> joined(n, 0);  // joined[k]: pair k (order[k] -> order[k + 1]) touches
+    for (std::size_t k = 0; k < geo.pairs(); ++k) {
+      double gap = (k + 1 < n ? unwrapped[k + 1] : unwrapped[0] + kTwoPi) - unwrapped[k] - geo.spacing[k];
+      if (gap < -kTouchTolerance_rad) over = true;
+      else if (gap <= kTouchTolerance_rad) joined[k] = 1, touch = true;
+    }
+    if (overlapping) *overlapping = over;
+    if (touching) *touching = touch;
+    if (over) {
+      model_.evaluate(state.data(), W, 0.0, modes.data(), mu_, f);
+      for (std::size_t i = 0; i < n; ++i) margins_out[i] = AbuModel::stick_margin(f, i, mu_);
+      return false;
+    }
+    if (touch) {
+      // Chains of touching balls from the rear to the front; start after a pair that is apart.
+      std::size_t start = 0;
+      while (start < n && joined[(start + n - 1) % n]) ++start;
+      if (start == n) {  // every pair touching: impossible while sum of spacings < 2 pi
+        for (std::size_t i = 0; i < n; ++i) margins_out[i] = -std::numeric_limits<double>::infinity();
+        return false;
+      }
+      Clusters cl;
+      for (std::size_t m = 0; m < n; ++m) {
+        const std::size_t k = (start + m) % n;
+        if (m == 0 || !joined[(k + n - 1) % n]) cl.groups.emplace_back();
+        cl.groups.back().push_back(geo.order[k]);
+      }
+      model_.evaluate_clusters(state.data(), W, 0.0, modes.data(), cl, mu_, f);
+      bool in = true;
+      for (std::size_t i = 0; i < n; ++i) {
+        // Per ball, in units of mu fn - |fw|: the weakest block it belongs to (for a single ball
+        // min(mu fn + fw, mu fn - fw) = mu fn - |fw|, the margin without contact).
+        margins_out[i] = std::min(f.margin_fwd[i], f.margin_bwd[i]) / nd_.mbar[i];
+        if (!(f.fn[i] > 0) || margins_out[i] < -tol_ * f.fn[i]) in = false;
+      }
+      return in;
+    }
+  }
   model_.evaluate(state.data(), W, 0.0, modes.data(), mu_, f);
   bool in = true;
   for (std::size_t i = 0; i < n; ++i) {
@@ -108,7 +159,8 @@ EquilibriumPoint EquilibriumSet::point(double frequency_hz, const std::vector<do
   p.margins.assign(n, 0.0);
   std::vector<double> state;
   ModelForces f(n);
-  p.in_set = evaluate_point(speed_ratio(frequency_hz), beta.data(), state, f, p.margins.data(), p.amplitude_mm);
+  p.in_set = evaluate_point(speed_ratio(frequency_hz), beta.data(), state, f, p.margins.data(), p.amplitude_mm,
+                            &p.overlapping, &p.touching);
   if (std::isfinite(p.amplitude_mm)) {
     p.fn = f.fn;
     p.fw = f.fw;
@@ -137,6 +189,7 @@ EquilibriumGrid EquilibriumSet::grid(double frequency_hz, std::size_t n, const s
   g.amplitude_mm.assign(n * n, 0.0);
   g.in_set.assign(n * n, 0);
   g.margins.assign(n * n * nb, 0.0);
+  if (params_.ball_contact == BallContact::Hard) g.excluded.assign(n * n, 0);
   const double W = speed_ratio(frequency_hz);
   std::vector<double> beta(nb), state;
   std::copy(other_beta.begin(), other_beta.end(), beta.begin() + 2);
@@ -146,7 +199,9 @@ EquilibriumGrid EquilibriumSet::grid(double frequency_hz, std::size_t n, const s
     for (std::size_t j = 0; j < n; ++j) {
       beta[1] = g.beta(j);
       const std::size_t k = g.index(i, j);
-      g.in_set[k] = evaluate_point(W, beta.data(), state, f, &g.margins[k * nb], g.amplitude_mm[k]) ? 1 : 0;
+      bool over = false;
+      g.in_set[k] = evaluate_point(W, beta.data(), state, f, &g.margins[k * nb], g.amplitude_mm[k], &over) ? 1 : 0;
+      if (!g.excluded.empty()) g.excluded[k] = over ? 1 : 0;
     }
   }
   return g;
@@ -197,6 +252,39 @@ EquilibriumScan EquilibriumSet::scan(double from_hz, double to_hz, double step_h
     }
   }
   return s;
+}
+
+double EquilibriumSet::ContactLine::coverage(int side) const {
+  const std::vector<char>& v = in_set[side == 0 ? 0 : 1];
+  if (v.empty()) return 0;
+  std::size_t c = 0;
+  for (char x : v) c += x ? 1 : 0;
+  return static_cast<double>(c) / static_cast<double>(v.size());
+}
+
+EquilibriumSet::ContactLine EquilibriumSet::contact_line(double frequency_hz, std::size_t n) const {
+  require_positive_frequency(frequency_hz, "frequency_hz");
+  if (params_.ball_contact != BallContact::Hard || n_balls() != 2)
+    throw std::invalid_argument("EquilibriumSet::contact_line: needs hard ball contact and two balls");
+  if (n < 1) throw std::invalid_argument("EquilibriumSet::contact_line: n must be >= 1");
+  ContactLine line;
+  line.spacing_rad = contact_spacing(params_, 0, 1);
+  line.n = n;
+  const double W = speed_ratio(frequency_hz);
+  std::vector<double> beta(2), state, margins(2);
+  ModelForces f(2);
+  double amp = 0;
+  for (int side = 0; side < 2; ++side) {
+    line.in_set[side].assign(n, 0);
+    for (std::size_t k = 0; k < n; ++k) {
+      beta[0] = kTwoPi * static_cast<double>(k) / static_cast<double>(n);
+      beta[1] = beta[0] + (side == 0 ? line.spacing_rad : -line.spacing_rad);
+      bool over = false, touch = false;
+      const bool in = evaluate_point(W, beta.data(), state, f, margins.data(), amp, &over, &touch);
+      line.in_set[side][k] = in && touch && !over ? 1 : 0;
+    }
+  }
+  return line;
 }
 
 double EquilibriumSet::full_coverage_margin(double frequency_hz) const {

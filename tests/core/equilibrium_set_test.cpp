@@ -1,6 +1,8 @@
 // Equilibrium sets against the closed forms of docs/equilibrium_sets.md.
 #include "abuopt/core/equilibrium_set.hpp"
 
+#include "abuopt/core/ball_contact.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -201,3 +203,85 @@ TEST(EquilibriumSet, UndampedResonanceIsOutside) {
   EXPECT_GT(pt.amplitude_mm, 1e6);
   EXPECT_FALSE(pt.in_set);
 }
+
+// --- hard ball contact (docs/equilibrium_sets.md section 5) ----------------------------------------
+
+namespace contact_tests {
+
+AbuParameters hard() {
+  AbuParameters p;
+  p.ball_contact = abuopt::BallContact::Hard;
+  return p;
+}
+
+TEST(EquilibriumSetContact, OverlappingPointsAreNeverInTheSetAndTheRestIsUnchanged) {
+  const AbuParameters pn;
+  const AbuParameters ph = hard();
+  for (double f : {10.0, 28.9, 100.0}) {
+    const auto gn = EquilibriumSet(pn).grid(f, 64);
+    const auto gh = EquilibriumSet(ph).grid(f, 64);
+    EXPECT_TRUE(gn.excluded.empty());
+    ASSERT_EQ(gh.excluded.size(), 64u * 64u);
+    std::size_t excluded = 0;
+    for (std::size_t i = 0; i < 64; ++i)
+      for (std::size_t j = 0; j < 64; ++j) {
+        const std::size_t k = gh.index(i, j);
+        const double clearance = abuopt::min_contact_clearance(ph, {gh.beta(i), gh.beta(j)});
+        EXPECT_EQ(gh.excluded[k] != 0, clearance < -1e-9) << f << " " << i << " " << j;
+        if (gh.excluded[k]) {
+          ++excluded;
+          EXPECT_EQ(gh.in_set[k], 0);
+        } else {  // apart (no grid point touches): exactly the no-contact answer
+          EXPECT_EQ(gh.in_set[k], gn.in_set[k]);
+          EXPECT_EQ(gh.margins[2 * k], gn.margins[2 * k]);
+          EXPECT_EQ(gh.margins[2 * k + 1], gn.margins[2 * k + 1]);
+        }
+      }
+    // |beta_1 - beta_2| < 0.2617 rad (mod 2 pi) on a 2 pi / 64 grid: the diagonal and 2 neighbours
+    // on each side, 5 of 64 per row.
+    EXPECT_EQ(excluded, 64u * 5u) << f;
+  }
+  const abuopt::EquilibriumPoint p = EquilibriumSet(ph).point(10.0, {1.0, 1.1});
+  EXPECT_TRUE(p.overlapping);
+  EXPECT_FALSE(p.in_set);
+}
+
+// A touching pair is one stuck cluster (docs/model.md 11.4): with N_i = mbar_i fw_i and
+// C_i = mbar_i mu fn_i from the no-contact forces (the same steady state), the rear ball's margin is
+// min(C_r + N_r, C_r + C_f - N_r - N_f) / mbar_r and the front's min(C_f - N_f, C_r + C_f + N_r + N_f) / mbar_f.
+TEST(EquilibriumSetContact, TouchingPairIsJudgedAsOneCluster) {
+  const AbuParameters ph = hard();
+  const double delta = abuopt::contact_spacing(ph, 0, 1);
+  const double m = abuopt::NondimParameters::from(ph).mbar[0];
+  for (double f : {10.0, 28.5, 28.9, 29.5, 100.0})
+    for (double b1 : {0.0, 1.0, 2.5, 4.0}) {
+      const std::vector<double> beta{b1, b1 + delta};  // ball 1 rear, ball 2 front
+      const abuopt::EquilibriumPoint c = EquilibriumSet(ph).point(f, beta);
+      const abuopt::EquilibriumPoint n = EquilibriumSet(AbuParameters{}).point(f, beta);
+      ASSERT_TRUE(c.touching);
+      ASSERT_FALSE(c.overlapping);
+      const double mu = ph.friction_mu;
+      const double Cr = m * mu * n.fn[0], Nr = m * n.fw[0], Cf = m * mu * n.fn[1], Nf = m * n.fw[1];
+      const double rear = std::min(Cr + Nr, Cr + Cf - Nr - Nf) / m;
+      const double front = std::min(Cf - Nf, Cr + Cf + Nr + Nf) / m;
+      EXPECT_NEAR(c.margins[0], rear, 1e-12 * std::abs(n.fn[0])) << f << " " << b1;
+      EXPECT_NEAR(c.margins[1], front, 1e-12 * std::abs(n.fn[1])) << f << " " << b1;
+      EXPECT_EQ(c.in_set, rear >= -1e-9 * n.fn[0] && front >= -1e-9 * n.fn[1]) << f << " " << b1;
+    }
+}
+
+TEST(EquilibriumSetContact, TouchingPairsFarFromResonanceAreInTheSet) {
+  const EquilibriumSet set(hard());
+  for (double f : {10.0, 100.0}) {
+    ASSERT_GE(set.full_coverage_margin(f), 0.0);  // without contact the set covers the plane
+    const auto line = set.contact_line(f, 256);
+    EXPECT_DOUBLE_EQ(line.coverage(0), 1.0) << f;
+    EXPECT_DOUBLE_EQ(line.coverage(1), 1.0) << f;
+  }
+  // Near resonance part of the contact line is outside (the cluster needs more than its cone).
+  const auto near = set.contact_line(28.9, 256);
+  EXPECT_LT(near.coverage(0), 1.0);
+  EXPECT_THROW(EquilibriumSet(AbuParameters{}).contact_line(10.0, 16), std::invalid_argument);
+}
+
+}  // namespace contact_tests

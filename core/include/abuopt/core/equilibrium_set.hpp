@@ -43,6 +43,10 @@ struct EquilibriumPoint {
   std::vector<double> margins;   // mu fn_i - |fw_i| per ball (>= 0: inside the cone)
   double min_margin = 0;         // smallest of margins
   bool in_set = false;
+  // abu.ball_contact: hard only (docs/equilibrium_sets.md section 5): two balls overlap (never in
+  // the set), or some pair touches (its balls are judged as one stuck cluster).
+  bool overlapping = false;
+  bool touching = false;
 };
 
 // An n x n grid over (beta_1, beta_2) in [0, 2 pi)^2, beta_k = 2 pi k / n, row-major:
@@ -56,6 +60,9 @@ struct EquilibriumGrid {
   std::vector<double> amplitude_mm;   // n*n
   std::vector<char> in_set;           // n*n (1 in the set)
   std::vector<double> margins;        // n*n*n_balls: margins[index * n_balls + ball]
+  // abu.ball_contact: hard: 1 where two balls overlap (excluded: not a configuration). Empty
+  // without contact.
+  std::vector<char> excluded;
   double beta(std::size_t k) const;
   std::size_t index(std::size_t i, std::size_t j) const { return i * n + j; }
   double coverage() const;            // fraction of grid points in the set
@@ -103,6 +110,18 @@ class EquilibriumSet {
   EquilibriumScan scan(double from_hz, double to_hz, double step_hz, std::size_t n,
                        const std::vector<double>& other_beta = {}) const;
 
+  // abu.ball_contact: hard, two balls: the contact lines beta_2 = beta_1 +- delta (delta the least
+  // spacing), sampled at beta_1 = 2 pi k / n. in_set[side][k], side 0: ball 2 ahead of ball 1
+  // (beta_2 = beta_1 + delta), side 1: behind. Throws std::invalid_argument without hard contact
+  // or for other than two balls.
+  struct ContactLine {
+    double spacing_rad = 0;
+    std::size_t n = 0;
+    std::vector<char> in_set[2];
+    double coverage(int side) const;  // fraction of the line's samples in the set
+  };
+  ContactLine contact_line(double frequency_hz, std::size_t n) const;
+
   // Closed form: min over balls of mu (1 + mbar_i Re G) - mbar_i |Im G| - sqrt(1 + mu^2) |G| R_i.
   // >= 0: every configuration is in the set (coverage 1 over the continuous torus).
   double full_coverage_margin(double frequency_hz) const;
@@ -114,7 +133,8 @@ class EquilibriumSet {
 
  private:
   bool evaluate_point(double W, const double* beta, std::vector<double>& state, ModelForces& f,
-                      double* margins_out, double& amp_mm) const;
+                      double* margins_out, double& amp_mm, bool* overlapping = nullptr,
+                      bool* touching = nullptr) const;
   AbuParameters params_;
   NondimParameters nd_;
   AbuModel model_;
