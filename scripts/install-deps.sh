@@ -16,6 +16,8 @@ packages=(
   libgtest-dev           # tests
   libbenchmark-dev       # bench/
   gnuplot-nox            # plots (optional at run time: studies skip plots without it)
+  clang libclang-rt-14-dev  # libFuzzer targets (fuzz/, scripts/fuzz.sh) with ASan/UBSan runtimes
+  python3                # scripts/startup_study.py, scripts/final_states_in_set.py (standard library only)
 )
 
 missing=()
