@@ -16,6 +16,8 @@ packages=(
   libgtest-dev           # tests
   libbenchmark-dev       # bench/
   gnuplot-nox            # plots (optional at run time: studies skip plots without it)
+  python3-dev pybind11-dev python3-numpy  # the Python module abuopt (python/; skipped without them)
+  python3-scipy python3-matplotlib        # examples/python (each says so and exits 0 without its package)
 )
 
 missing=()
