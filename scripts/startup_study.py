@@ -479,8 +479,8 @@ def final_positions_plot(st, table, names, gp):
                 b2 = float(r["beta_final_2"]) % (2 * math.pi)
                 f.write(f"{b1:.5f},{b2:.5f},{float(r['ir_magnitude_kgm']) / 1e-7:.4f}\n")
         below = sum(1 for r in rows if float(r["ir_magnitude_kgm"]) / 1e-7 < r_lock) / len(rows) * 100
-        body = (f"set title '{n}: final ball angles of {len(rows)} fresh starts over the equilibrium set at "
-                f"{f_med:.2f} Hz (median settling speed); {below:.0f} % below r_lock'\n"
+        body = (f"set title '{n}: final angles of {len(rows)} fresh starts over the set at {f_med:.2f} Hz\\n"
+                f"(the median settling speed); {below:.0f} % below r_lock = 15.9e-7'\n"
                 "set xlabel 'beta_1 [rad]'; set ylabel 'beta_2 [rad]'; set size square; set xrange [0:6.2832]; "
                 "set yrange [0:6.2832]\nset datafile separator ','\nset cblabel 'final |I_r| [1e-7 kg m]'\n"
                 "set palette defined (0 'blue', 15.9 'green', 20.7 'orange', 35 'red'); set cbrange [0:35]\n"
@@ -491,7 +491,7 @@ def final_positions_plot(st, table, names, gp):
                 "'+' using (4.0134):(2.2698) with points pt 3 ps 2 lc rgb 'black' notitle")
         p = os.path.join(out, f"final_{n}.gp")
         with open(p, "w") as f:
-            f.write(f"set terminal pngcairo size 900,850\nset output 'final_{n}.png'\n{body.replace(chr(39) + '+' + chr(39), chr(39) + '+' + chr(39))}\n")
+            f.write(f"set terminal pngcairo size 900,850 noenhanced\nset output 'final_{n}.png'\n{body.replace(chr(39) + '+' + chr(39), chr(39) + '+' + chr(39))}\n")
         if gp:
             subprocess.run([gp, os.path.basename(p)], cwd=out, capture_output=True)
 
@@ -525,15 +525,17 @@ def make_plots(st, table, designs, best19):
                              "plot " + ", ".join(f"'profiles.dat' index {k} with lines title '{n}'" for k, n in enumerate(names)),
         "front.png": "set title 'startup time against mean |I_r| (1024 fresh starts, 95 % intervals)'\n"
                      "set xlabel 'startup time [s]'; set ylabel 'mean |I_r| [1e-7 kg m]'; set y2label '%MI(|I_r|) [%]'\n"
-                     "set ytics nomirror; set y2tics; set key top right\n"
+                     "set ytics nomirror; set y2tics; set key top right; set xrange [3:20]; set yrange [0:40]\n"
                      "plot 'front.dat' using 1:2:3:4 with yerrorbars pt 7 title 'mean |I_r|', "
                      "'front.dat' using 1:5 axes x1y2 with points pt 6 ps 1.5 title '%MI (right axis)', "
-                     "'front.dat' using 1:2:6 with labels offset 0,1 font ',7' notitle, 7.0 with lines dt 2 title 'goal 7.0'",
+                     "'front.dat' using 1:($1 < 16 || strcol(6) eq 'report_2003' || strcol(6) eq 'f1_k4_hold' ? $2 : 1/0):6 "
+                     "with labels offset 0,1.2 font ',8' notitle, 7.0 with lines dt 2 title 'goal 7.0', "
+                     "11.48 with lines dt 3 title 'pair floor 11.48 (balls together)'",
     }
     for png, body in scripts.items():
         p = os.path.join(out, png.replace(".png", ".gp"))
         with open(p, "w") as f:
-            f.write(f"set terminal pngcairo size 1000,650\nset output '{png}'\nset grid\n{body}\n")
+            f.write(f"set terminal pngcairo size 1000,650 noenhanced\nset output '{png}'\nset grid\n{body}\n")
         if gp:
             subprocess.run([gp, os.path.basename(p)], cwd=out, capture_output=True)
 

@@ -31,6 +31,7 @@
 #include <nlohmann/json.hpp>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/common/output_file.hpp"
 #include "abuopt/optimizer/benchmarking.hpp"
 #include "abuopt/optimizer/benchmarks/benchmark_factory.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
@@ -109,6 +110,7 @@ int run_compare(const CompareArgs& a) {
   YamlReader root = YamlReader::load_file(a.config);
   opt::ComparisonSetup setup;
   setup.tau = root.get_double_or("tau", setup.tau, Rule::in_range(1e-12, 0.999));
+  setup.threads = static_cast<int>(root.get_int_or("threads", setup.threads, Rule::in_range(1, 256)));
   for (YamlReader& p : root.children("problems")) setup.problems.push_back(read_problem(p));
   for (YamlReader& s : root.children("solvers")) setup.solvers.push_back(opt::read_solver_spec(s));
   root.finish();
@@ -123,9 +125,10 @@ int run_compare(const CompareArgs& a) {
     std::cerr << "[" << done << "/" << total << "] " << r.problem << " start " << r.start << " " << r.solver << ": "
               << r.result.brief_report() << "\n";
   };
+  const std::string out = a.out.empty() ? "results/compare-" + timestamp() : a.out;
+  const OutputDirLock lock(out);  // one run per output directory (created here)
   const opt::ComparisonResult result = opt::run_comparison(setup);
 
-  const std::string out = a.out.empty() ? "results/compare-" + timestamp() : a.out;
   const opt::WrittenFiles files = opt::write_comparison(result, out);
 
   if (a.json) {

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/common/output_file.hpp"
 #include "abuopt/common/config_fields.hpp"
 #include "abuopt/common/gnuplot.hpp"
 #include "abuopt/core/equilibrium_residual.hpp"
@@ -28,6 +29,8 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr long kMaxGrid = 4096;
+// The steady amplitude grows with (2 pi f)^4 terms: 1e6 Hz keeps every product finite.
+constexpr double kMaxFrequencyHz = 1e6;
 constexpr std::size_t kMaxScanPoints = 100000;
 
 struct EqsetArgs {
@@ -127,8 +130,7 @@ int run_single(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig&
   const fs::path dir = make_out_dir(a.out.empty() ? "results/eqset-" + num_text(freq) + "Hz" : a.out, "--out");
   const fs::path csv = dir / "equilibrium_set.csv";
   {
-    std::ofstream f(csv);
-    if (!f) throw ConfigError("--out", dir.string(), "must be writable (" + csv.string() + ")");
+    AtomicFile f(csv);
     f << "beta1_rad,beta2_rad,amplitude_mm,in_set";
     for (std::size_t b = 0; b < nb; ++b) f << ",margin_" << b + 1;
     f << "\n" << std::setprecision(10);
@@ -139,6 +141,7 @@ int run_single(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig&
         for (std::size_t b = 0; b < nb; ++b) f << "," << g.margins[k * nb + b];
         f << "\n";
       }
+    f.commit();
   }
   double in_min = INFINITY, in_max = -INFINITY;
   for (std::size_t k = 0; k < n * n; ++k)
@@ -252,12 +255,10 @@ int run_scan(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig& c
   if (!a.out.empty()) {
     const fs::path dir = make_out_dir(a.out, "--out");
     csv_path = (dir / "coverage.csv").string();
-    std::ofstream f(csv_path);
-    if (!f) throw ConfigError("--out", dir.string(), "must be writable (" + csv_path + ")");
+    AtomicFile f(csv_path);
     f << "frequency_hz,coverage\n" << std::setprecision(10);
     for (std::size_t k = 0; k < s.frequency_hz.size(); ++k) f << s.frequency_hz[k] << "," << s.coverage[k] << "\n";
-    f.close();
-    if (!f) throw ConfigError("--out", dir.string(), "must be writable (" + csv_path + ")");
+    f.commit();
     XYLinesPlot plot;
     plot.csv_path = csv_path;
     plot.png_path = (dir / "coverage.png").string();
@@ -270,16 +271,14 @@ int run_scan(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig& c
     plot_text = ps.ran() ? plot.png_path : ps.message;
 
     residual_csv = (dir / "residual.csv").string();
-    std::ofstream r(residual_csv);
-    if (!r) throw ConfigError("--out", dir.string(), "must be writable (" + residual_csv + ")");
+    AtomicFile r(residual_csv);
     r << kResidualHeader << "\n" << std::setprecision(10);
     for (const auto& e : res) {
       const auto row = residual_row(e);
       for (std::size_t c = 0; c < row.size(); ++c) r << (c ? "," : "") << row[c];
       r << "\n";
     }
-    r.close();
-    if (!r) throw ConfigError("--out", dir.string(), "must be writable (" + residual_csv + ")");
+    r.commit();
     XYLinesPlot rp;
     rp.csv_path = residual_csv;
     rp.png_path = (dir / "residual.png").string();
@@ -363,8 +362,9 @@ int run_scan(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig& c
 
 int run_eqset(const EqsetArgs& a) {
   // Option values first: a bad option is reported before the config is read.
-  if (a.freq && !(std::isfinite(*a.freq) && *a.freq > 0))
-    throw ConfigError("--freq", num_text(*a.freq), "must be a frequency > 0 Hz");
+  if (a.freq && !(std::isfinite(*a.freq) && *a.freq > 0 && *a.freq <= kMaxFrequencyHz))
+    throw ConfigError("--freq", num_text(*a.freq),
+                      "must be a frequency in (0, 1e6] Hz (above it the steady amplitude overflows double precision)");
   if (a.grid && (*a.grid < 2 || *a.grid > kMaxGrid))
     throw ConfigError("--grid", std::to_string(*a.grid), "must be in [2, " + std::to_string(kMaxGrid) + "] (points per axis)");
   if (a.mu && !(std::isfinite(*a.mu) && *a.mu >= 0 && *a.mu < 1))

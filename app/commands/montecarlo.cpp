@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/common/output_file.hpp"
 #include "abuopt/core/monte_carlo.hpp"
 #include "abuopt/core/monte_carlo_stats.hpp"
 #include "abuopt/core/simulation_config.hpp"
@@ -140,17 +141,10 @@ class ProgressBar {
 };
 
 void write_outputs(const std::string& dir, const MonteCarloResult& result, const nlohmann::json& summary) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) throw ConfigError("--out", dir, "cannot be created (" + ec.message() + ")");
-  const std::string csv = (std::filesystem::path(dir) / "runs.csv").string();
-  std::ofstream f(csv);
-  if (!f) throw ConfigError("--out", dir, "cannot write " + csv);
-  write_runs_csv(f, result.samples);
-  const std::string js = (std::filesystem::path(dir) / "summary.json").string();
-  std::ofstream g(js);
-  if (!g) throw ConfigError("--out", dir, "cannot write " + js);
-  g << summary.dump(2) << "\n";
+  AtomicFile csv(std::filesystem::path(dir) / "runs.csv");
+  write_runs_csv(csv.stream(), result.samples);
+  csv.commit();
+  write_file_atomic(std::filesystem::path(dir) / "summary.json", summary.dump(2) + "\n");
 }
 
 int run_montecarlo(const MonteCarloArgs& a) {
@@ -159,6 +153,8 @@ int run_montecarlo(const MonteCarloArgs& a) {
   MonteCarloConfig cfg = read_monte_carlo_config(root, std::move(setup));
   root.finish();
   apply_overrides(a, cfg);
+  std::optional<OutputDirLock> lock;  // one run per output directory
+  if (!a.out.empty()) lock.emplace(a.out);
 
   const MonteCarloStudy& s = cfg.study;
   auto sim = std::make_shared<const Simulator>(s.setup);  // validates the setup

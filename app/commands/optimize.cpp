@@ -18,6 +18,7 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/gnuplot.hpp"
+#include "abuopt/common/output_file.hpp"
 #include "abuopt/common/text.hpp"
 #include "abuopt/core/simulation_config.hpp"
 #include "abuopt/optimizer/evaluation_archive.hpp"
@@ -108,17 +109,11 @@ nlohmann::json evaluation_json(const opt::Evaluation& e, const std::vector<std::
 
 std::string csv_text(const std::string& s) { return csv_field(s); }
 
-std::ofstream open_out(const fs::path& p) {
-  std::ofstream f(p);
-  if (!f) throw ConfigError("--out", p.parent_path().string(), "cannot write " + p.string());
-  return f;
-}
-
 void write_history_csv(const fs::path& path, const opt::OptimizationResult& r) {
   std::set<std::string> metric_names;
   for (const auto& h : r.history)
     for (const auto& [k, v] : h.metrics) metric_names.insert(k);
-  std::ofstream f = open_out(path);
+  AtomicFile f(path);
   f << "evaluation,from_archive,for_gradient,ok,feasible,objective,max_violation";
   for (const auto& n : r.variable_names) f << "," << n;
   for (const auto& n : r.inequality_names) f << ",g_" << n;
@@ -136,13 +131,14 @@ void write_history_csv(const fs::path& path, const opt::OptimizationResult& r) {
     }
     f << "," << csv_number(h.wall_time_s) << "," << csv_number(h.elapsed_s) << "," << csv_text(h.message) << "\n";
   }
+  f.commit();
 }
 
 // convergence.csv (+ .png): objective of every evaluation, of the feasible ones, best feasible so far.
 std::string write_convergence(const fs::path& dir, const opt::OptimizationResult& r) {
   const fs::path csv = dir / "convergence.csv", png = dir / "convergence.png";
   {
-    std::ofstream f = open_out(csv);
+    AtomicFile f(csv);
     f << "evaluation,objective,feasible_objective,best_feasible_objective,max_violation\n";
     double best = std::numeric_limits<double>::infinity();
     for (const auto& h : r.history) {
@@ -151,6 +147,7 @@ std::string write_convergence(const fs::path& dir, const opt::OptimizationResult
         << (h.feasible ? format_number(h.objective) : "") << "," << (std::isfinite(best) ? format_number(best) : "")
         << "," << (std::isfinite(h.max_violation) ? format_number(h.max_violation) : "") << "\n";
     }
+    f.commit();
   }
   Gnuplot gp;
   if (!gp.available()) return "convergence plot skipped: gnuplot not found (data in " + csv.string() + ")";
@@ -168,13 +165,14 @@ void write_best_profile(const fs::path& path, const StartupProfileProblem& probl
                         const std::string& config) {
   SimulationSetup setup = problem.settings().study.setup;
   setup.profile = problem.profile_at(r.x);
-  std::ofstream f = open_out(path);
+  AtomicFile f(path);
   f << "# Best startup profile of `abuopt optimize " << config << "` (" << r.algorithm << ", "
     << r.evaluations << " evaluations, " << to_string(r.reason) << ").\n"
     << "# " << vector_text(problem.variables(), r.x) << "; objective " << format_number(r.objective)
     << (r.feasible ? " (feasible)" : " (NOT feasible)") << "\n"
     << "# Run it: abuopt simulate " << path.string() << "   (or add a montecarlo section for abuopt montecarlo)\n"
     << to_yaml(setup);
+  f.commit();
 }
 
 int run_optimize(const OptimizeArgs& a) {
@@ -189,9 +187,7 @@ int run_optimize(const OptimizeArgs& a) {
   const std::vector<std::string> g_names = optimised.inequality_names();
 
   const fs::path out = a.out.empty() ? fs::path("results") / fs::path(a.config).stem() : fs::path(a.out);
-  std::error_code ec;
-  fs::create_directories(out, ec);
-  if (ec) throw ConfigError("--out", out.string(), "cannot be created (" + ec.message() + ")");
+  const OutputDirLock lock(out);  // creates it; one run per output directory
   const std::string id = problem.identity();
   opt::EvaluationArchive archive((out / "archive.sqlite").string(), id);
   opt::ArchivedProblem archived(optimised, archive);
@@ -306,7 +302,7 @@ int run_optimize(const OptimizeArgs& a) {
   if (have_best) j["files"]["best_profile"] = (out / "best_profile.yaml").string();
   j["convergence_plot"] = plot_message;
   const fs::path result_json = out / "result.json";
-  auto write_json = [&] { open_out(result_json) << j.dump(2) << "\n"; };
+  auto write_json = [&] { write_file_atomic(result_json, j.dump(2) + "\n"); };
   write_json();
 
   const bool interrupted = r.reason == opt::TerminationReason::Interrupted;
@@ -338,6 +334,12 @@ int run_optimize(const OptimizeArgs& a) {
       << plot_message << "\n";
   if (a.json) std::cout << j.dump(2) << "\n";
   if (interrupted) return 130;
+  if (r.reason == opt::TerminationReason::EvaluationError) {
+    std::cerr << "abuopt: error: the optimisation ended on an evaluation error: "
+              << (r.message.empty() ? std::string("(no message)") : r.message)
+              << " (the files above hold the evaluations up to it)\n";
+    return 3;
+  }
   return r.has_feasible_point() ? 0 : 3;
 }
 
@@ -352,7 +354,8 @@ void register_optimize(CLI::App& app) {
       "the same initial ball angles; constraints on startup time, amplitude and %MI. Every evaluation\n"
       "is archived in OUT/archive.sqlite: rerunning the same command resumes. At the end the best design\n"
       "and the report's final profile are evaluated on a fresh, larger set of initial conditions.\n"
-      "Exit status: 0 ok, 2 bad input, 3 no feasible design found, 130 interrupted (Ctrl-C).");
+      "Exit status: 0 ok, 2 bad input, 3 no feasible design found or the run ended on an evaluation\n"
+      "error (the reason is printed), 4 an output file could not be written, 130 interrupted (Ctrl-C).");
   sub->add_option("config", args->config,
                   "YAML config (abu, profile, motor, simulation, montecarlo, design, objective, constraints,\n"
                   "validation, optimizer, sao); see configs/optimize/ and docs/optimize.md")

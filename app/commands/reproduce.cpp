@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/common/output_file.hpp"
 #include "abuopt/studies/reproduction.hpp"
 #include "commands/commands.hpp"
 
@@ -98,6 +99,7 @@ int run_reproduce(const ReproduceArgs& a) {
   else std::cout << "run counts as in the report (1024 or 256 per case); --runs N for a quicker look\n";
   std::cout << "output: " << opt.out_dir << "\n" << std::flush;
 
+  const OutputDirLock lock(opt.out_dir);  // one run per output directory
   const ReproductionReport r = run_reproduction(tables, opt);
 
   std::cout << "\n";
@@ -131,7 +133,8 @@ void register_reproduce(CLI::App& app) {
       "configs/report/*.yaml and print each table side by side with the published values (report's I_r,x:\n"
       "mean, max, %LC, %MI; our 95 % Wilson interval of %MI; the magnitude |I_r| as extra columns), with a\n"
       "verdict per published conclusion. Writes per-case run CSVs (as each case ends), tables.csv,\n"
-      "report.md and plots into --out. Exit status: 0 ok, 2 bad input, 3 every run of some case failed.");
+      "report.md and plots into --out. Exit status: 0 ok, 2 bad input, 3 every run of some case failed,\n"
+      "4 an output file could not be written.");
   sub->add_option("--runs", args->runs,
                   "runs per case for every case: an n x n grid with n = round(sqrt(N)) (default: the report's counts)");
   sub->add_option("--only", args->only, "comma-separated table ids: 4.1, 4.2, 4.3, 4.4, final, mu (default: all)")

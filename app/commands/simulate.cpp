@@ -1,4 +1,5 @@
 // abuopt simulate CONFIG: one startup from given initial ball angles; prints the outcome.
+#include <optional>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -8,6 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/common/output_file.hpp"
+#include "abuopt/common/text.hpp"
 #include "abuopt/core/monte_carlo.hpp"
 #include "abuopt/core/simulation_config.hpp"
 #include "abuopt/core/simulator.hpp"
@@ -20,7 +23,7 @@ namespace {
 struct SimulateArgs {
   std::string config;
   std::string beta0;
-  double mu = -1;
+  std::optional<double> mu;
   std::string trajectory;
   double trajectory_interval_s = 0.01;
   bool json = false;
@@ -50,7 +53,13 @@ int run_simulate(const SimulateArgs& a) {
   // A montecarlo section (a config that `abuopt montecarlo` also runs) is checked and not used.
   if (root.has("montecarlo")) (void)read_monte_carlo_config(root, setup);
   root.finish();
-  if (a.mu >= 0) setup.abu.friction_mu = a.mu;
+  if (a.mu) {
+    if (!(std::isfinite(*a.mu) && *a.mu >= 0 && *a.mu <= 0.999))
+      throw ConfigError("--mu", format_number(*a.mu), "must be a friction coefficient in [0, 0.999]");
+    setup.abu.friction_mu = *a.mu;
+  }
+  if (!(std::isfinite(a.trajectory_interval_s) && a.trajectory_interval_s > 0))
+    throw ConfigError("--trajectory-interval", format_number(a.trajectory_interval_s), "must be a finite interval > 0 s");
   if (!a.trajectory.empty()) setup.options.trajectory_interval_s = a.trajectory_interval_s;
   const std::size_t n = setup.abu.balls.size();
   std::vector<double> beta0;
@@ -60,12 +69,21 @@ int run_simulate(const SimulateArgs& a) {
     for (std::size_t i = 0; i < n; ++i) beta0.push_back(2.0 * M_PI * (i + 0.5) / static_cast<double>(n) + 0.3);
   }
   Simulator sim(setup);
+  if (!a.trajectory.empty()) {
+    // The trajectory is kept in memory: cap what one request may ask for.
+    constexpr double kMaxTrajectoryRows = 1e7;
+    const double rows = sim.end_time_s() / a.trajectory_interval_s;
+    if (rows > kMaxTrajectoryRows)
+      throw ConfigError("--trajectory-interval", format_number(a.trajectory_interval_s),
+                        "gives " + format_significant(rows, 3) + " samples over the " + format_number(sim.end_time_s()) +
+                            " s run: at most 1e7 are allowed (about 1 GB); choose an interval >= " +
+                            format_significant(sim.end_time_s() / kMaxTrajectoryRows, 3) + " s");
+  }
   std::vector<TrajectoryPoint> traj;
   const RunOutcome o = sim.run(beta0, {}, a.trajectory.empty() ? nullptr : &traj);
 
   if (!a.trajectory.empty()) {
-    std::ofstream f(a.trajectory);
-    if (!f) throw ConfigError("--trajectory", a.trajectory, "cannot be written");
+    AtomicFile f(a.trajectory);
     f << "t_s,frequency_hz,x_m,y_m";
     for (std::size_t i = 0; i < n; ++i) f << ",beta" << i + 1 << "_rad";
     for (std::size_t i = 0; i < n; ++i) f << ",mode" << i + 1;
@@ -76,6 +94,7 @@ int run_simulate(const SimulateArgs& a) {
       for (int m : p.mode) f << "," << m;
       f << "\n";
     }
+    f.commit();
   }
 
   const double I0 = setup.abu.imbalance_kgm();

@@ -46,6 +46,19 @@ fs::path temp_name(const fs::path& path) {
 }  // namespace
 
 void write_file_atomic(const fs::path& path, const std::string& text) {
+  // A device, FIFO or other special file (/dev/null, /dev/stdout, a pipe) is written directly:
+  // renaming a temporary over it would replace the device with a regular file.
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (!ec && fs::exists(st) && !fs::is_regular_file(st)) {
+    if (fs::is_directory(st)) throw OutputError("cannot write " + path.string() + ": it is a directory");
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+    if (fd < 0) fail(path, "cannot open it", errno);
+    int e = write_all(fd, text.data(), text.size());
+    if (::close(fd) != 0 && e == 0) e = errno;
+    if (e != 0) fail(path, "writing failed", e);
+    return;
+  }
   const fs::path tmp = temp_name(path);
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) fail(path, "cannot create " + tmp.string(), errno);

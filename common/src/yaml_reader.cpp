@@ -2,6 +2,8 @@
 
 #include <cerrno>
 #include <cmath>
+#include <filesystem>
+#include <set>
 #include <cstdlib>
 #include <sstream>
 
@@ -50,10 +52,45 @@ YamlReader::YamlReader(YAML::Node node, std::string path) : node_(std::move(node
   }
 }
 
+namespace {
+
+// Every mapping of the document must have each key once: yaml-cpp keeps both entries of a
+// duplicate key and a lookup silently sees the first, so `friction_mu` twice (or two `abu:`
+// sections) would keep one of them without a word.
+void check_unique_keys(const YAML::Node& n, const std::string& path, const std::string& where) {
+  if (n.IsMap()) {
+    std::set<std::string> seen;
+    for (auto it = n.begin(); it != n.end(); ++it) {
+      const std::string k = it->first.IsScalar() ? it->first.Scalar() : yaml_value_text(it->first);
+      const std::string kp = path.empty() ? k : path + "." + k;
+      if (!seen.insert(k).second)
+        throw ConfigError(where + kp, yaml_value_text(it->second),
+                          "appears twice in the same mapping (line " + std::to_string(it->first.Mark().line + 1) +
+                              "): give each key once");
+      check_unique_keys(it->second, kp, where);
+    }
+  } else if (n.IsSequence()) {
+    for (std::size_t i = 0; i < n.size(); ++i) check_unique_keys(n[i], path + "[" + std::to_string(i) + "]", where);
+  }
+}
+
+// One document per config: a second one (after a `---` line) would be ignored.
+YAML::Node single_document(const std::vector<YAML::Node>& docs, const std::string& what) {
+  if (docs.size() > 1)
+    throw ConfigError(what + " holds " + std::to_string(docs.size()) +
+                      " YAML documents (a line '---' starts a new one): a config is one document");
+  return docs.empty() ? YAML::Node() : docs.front();
+}
+
+}  // namespace
+
 YamlReader YamlReader::load_file(const std::string& file) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec))
+    throw ConfigError("config file '" + file + "' is a directory, not a YAML file");
   YAML::Node n;
   try {
-    n = YAML::LoadFile(file);
+    n = single_document(YAML::LoadAllFromFile(file), "config file '" + file + "'");
   } catch (const YAML::BadFile&) {
     throw ConfigError("config file '" + file + "' cannot be opened (missing or unreadable)");
   } catch (const YAML::ParserException& e) {
@@ -61,16 +98,18 @@ YamlReader YamlReader::load_file(const std::string& file) {
                       ", column " + std::to_string(e.mark.column + 1) + ": " + e.msg);
   }
   if (!n || n.IsNull()) throw ConfigError("config file '" + file + "' is empty");
+  check_unique_keys(n, "", "config file '" + file + "': ");
   return YamlReader(n, "");
 }
 
 YamlReader YamlReader::load_string(const std::string& text, const std::string& name) {
   YAML::Node n;
   try {
-    n = YAML::Load(text);
+    n = single_document(YAML::LoadAll(text), "config '" + name + "'");
   } catch (const YAML::ParserException& e) {
     throw ConfigError("config '" + name + "' is not valid YAML: line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }
+  if (n) check_unique_keys(n, "", "");
   return YamlReader(n, "");
 }
 
@@ -236,7 +275,9 @@ std::vector<YamlReader> YamlReader::children(const std::string& key) {
 void YamlReader::finish() const {
   if (!present()) return;
   for (auto it = node_.begin(); it != node_.end(); ++it) {
-    const std::string k = it->first.as<std::string>();
+    // A key that is not a scalar ({[a, b]: 1}) is never a known key; as<std::string>() would throw
+    // YAML's own exception (an internal error instead of a config error).
+    const std::string k = it->first.IsScalar() ? it->first.Scalar() : yaml_value_text(it->first);
     if (!read_.count(k)) {
       throw ConfigError(key_path(k), yaml_value_text(it->second), "unknown key (misspelt, or not valid here)");
     }

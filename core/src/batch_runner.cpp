@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <exception>
 #include <mutex>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -56,7 +58,17 @@ void ThreadPoolRunner::run(std::size_t count, const std::function<void(std::size
   } else {
     std::vector<std::thread> pool;
     pool.reserve(workers - 1);
-    for (std::size_t w = 1; w < workers; ++w) pool.emplace_back(worker);
+    // The system may refuse a thread (process or memory limits): go on with the ones it gave,
+    // and say so, instead of leaving joinable threads to std::terminate.
+    for (std::size_t w = 1; w < workers; ++w) {
+      try {
+        pool.emplace_back(worker);
+      } catch (const std::system_error& e) {
+        std::fprintf(stderr, "abuopt: warning: the system started only %zu of the %zu worker threads asked for (%s); "
+                     "going on with %zu\n", pool.size() + 1, workers, e.what(), pool.size() + 1);
+        break;
+      }
+    }
     worker();  // the calling thread works too
     for (auto& t : pool) t.join();
   }

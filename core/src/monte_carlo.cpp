@@ -86,6 +86,12 @@ void validate(const MonteCarloStudy& s, const std::string& path) {
   const std::string p = path.empty() ? "" : path + ".";
   if (s.setup.abu.balls.empty()) throw ConfigError("abu.balls", "[]", "must hold at least one ball for a Monte Carlo");
   if (s.runs < 1) throw ConfigError(p + "runs", std::to_string(s.runs), "must be >= 1");
+  // Every run's outcome is kept in memory (about 0.5 kB each): cap what one request may allocate.
+  constexpr std::size_t kMaxRuns = 10'000'000;
+  if (s.runs > kMaxRuns)
+    throw ConfigError(p + "runs", std::to_string(s.runs),
+                      "must be <= 10000000 (the per-request memory limit, about 5 GB of outcomes; run several studies "
+                      "with different seeds for more, or raise kMaxRuns in core/src/monte_carlo.cpp)");
   const InitialConditionDesign d = study_design(s);
   validate(d, path);
   if (d.kind == InitialConditionKind::Grid && d.size() != s.runs)

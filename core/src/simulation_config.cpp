@@ -63,8 +63,12 @@ void describe_fields(FieldArchive& a, AbuParameters& p) {
   a.field("friction_mu", p.friction_mu, Rule::in_range(0.0, 0.999));
   a.field("ball_damping_Nms", p.ball_damping_Nms, Rule::non_negative());
   a.items("balls", p.balls);
-  if (a.mode() == FieldArchive::Mode::Read || a.mode() == FieldArchive::Mode::Validate)
+  if (a.mode() == FieldArchive::Mode::Read || a.mode() == FieldArchive::Mode::Validate) {
+    if (p.balls.size() > 64)  // the same limit as ball_count: run time grows with the square of the count
+      throw ConfigError((a.here().empty() ? "" : a.here() + ".") + "balls", std::to_string(p.balls.size()) + " balls",
+                        "must hold at most 64 balls (as ball_count; the limit is in core/src/simulation_config.cpp)");
     check_balls_fit(p, a.here());
+  }
 }
 
 void describe_fields(FieldArchive& a, InclinedSineSegment& s) {

@@ -2,7 +2,9 @@
 #include "abuopt/optimizer/benchmarking.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -10,6 +12,7 @@
 #include <random>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/gnuplot.hpp"
@@ -184,14 +187,21 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
     std::unique_ptr<Problem> probe = spec.make();
     const auto starts = starting_points(*probe, spec.starts, spec.seed);
     const std::size_t first_run = out.runs.size();
-    for (int k = 0; k < spec.starts; ++k) {
-      for (const SolverSpec& solver : setup.solvers) {
+    // the runs of this problem are independent: each has its own problem instance, start and seed,
+    // and lands in its own slot, so the results do not depend on how many run at once
+    const std::size_t tasks = static_cast<std::size_t>(spec.starts) * setup.solvers.size();
+    out.runs.resize(first_run + tasks);
+    auto run_task = [&](std::size_t t) {
+      const int k = static_cast<int>(t / setup.solvers.size());
+      const SolverSpec& solver = setup.solvers[t % setup.solvers.size()];
+      {
         std::unique_ptr<Problem> problem = spec.make();
         OptimizerOptions o = solver.options;
         o.max_evaluations = spec.max_evaluations;
         o.constraint_tolerance = spec.constraint_tolerance;
         o.seed = spec.seed + static_cast<unsigned long>(k);
         o.keep_history = true;
+        o.handle_sigint = o.handle_sigint && setup.threads <= 1;  // one handler owner at a time
         RunRecord rec;
         rec.problem = spec.label;
         rec.solver = solver.label;
@@ -218,8 +228,28 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
         }
         rec.best_true_objective = best;
         rec.feasible = std::isfinite(best);
-        out.runs.push_back(std::move(rec));
+        out.runs[first_run + t] = std::move(rec);
       }
+    };
+    const std::size_t workers = std::min<std::size_t>(std::max(1, setup.threads), tasks);
+    if (workers <= 1) {
+      for (std::size_t t = 0; t < tasks; ++t) run_task(t);
+    } else {
+      std::atomic<std::size_t> next{0};
+      std::vector<std::exception_ptr> errors(workers);
+      std::vector<std::thread> pool;
+      for (std::size_t w = 0; w < workers; ++w)
+        pool.emplace_back([&, w] {
+          try {
+            for (std::size_t t = next++; t < tasks; t = next++) run_task(t);
+          } catch (...) {
+            errors[w] = std::current_exception();  // rethrown below, as a serial run would
+            next = tasks;
+          }
+        });
+      for (std::thread& th : pool) th.join();
+      for (const std::exception_ptr& e : errors)
+        if (e) std::rethrow_exception(e);
     }
     // the reference value f*
     double f_star = kInf;

@@ -1,8 +1,11 @@
 #include "abuopt/optimizer/optimizer_options.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/common/config_fields.hpp"
 #include "abuopt/optimizer/algorithms.hpp"
 #include "abuopt/optimizer/problem.hpp"
 
@@ -52,31 +55,47 @@ void OptimizerOptions::validate() const {
   require(print_level >= 0 && print_level <= 12, "print_level", print_level, "must be in [0, 12]");
 }
 
+void describe_fields(FieldArchive& a, OptimizerOptions& o) {
+  static const EnumNames<FiniteDifference> differences = {{FiniteDifference::Forward, "forward"},
+                                                          {FiniteDifference::Central, "central"}};
+  a.field("algorithm", o.algorithm);
+  FieldOptions local;
+  local.enabled = a.reading() || !o.local_algorithm.empty();  // empty: the default (never written)
+  a.field("local_algorithm", o.local_algorithm, local);
+  a.field("max_evaluations", o.max_evaluations, Rule::positive());
+  a.field("max_time_s", o.max_time_s, Rule::non_negative());
+  a.field("max_iterations", o.max_iterations, Rule::non_negative());
+  a.field("xtol_rel", o.xtol_rel, Rule::non_negative());
+  a.field("ftol_rel", o.ftol_rel, Rule::non_negative());
+  a.field("ftol_abs", o.ftol_abs, Rule::non_negative());
+  a.field("target", o.target);
+  a.field("constraint_tolerance", o.constraint_tolerance, Rule::non_negative());
+  a.field("finite_difference", o.finite_difference, differences);
+  a.field("fd_relative_step", o.fd_relative_step, Rule::in_range(0.0, 0.49));
+  a.field("seed", o.seed, Rule::non_negative());
+  a.field("population", o.population, Rule::non_negative());
+  a.field("initial_step", o.initial_step, Rule::in_range(0.0, 1.0));
+  a.field("print_level", o.print_level, Rule::in_range(0, 12));
+  a.field("handle_sigint", o.handle_sigint);
+  a.field("keep_history", o.keep_history);
+  // the sao section is written with algorithm SAO; reading it is read_optimizer_options' job (the
+  // settings may come from two places)
+  std::string upper = o.algorithm;
+  std::transform(upper.begin(), upper.end(), upper.begin(), [](unsigned char c) { return std::toupper(c); });
+  if (!a.reading() && upper == "SAO") a.nested("sao", o.sao);
+}
+
+std::string to_yaml(const OptimizerOptions& o) { return write_fields(o); }
+
 OptimizerOptions read_optimizer_options(YamlReader& r, YamlReader* sao_section) {
   OptimizerOptions o;
-  o.algorithm = r.get_string_or("algorithm", o.algorithm);
+  {
+    YamlReadArchive a(r);
+    describe_fields(a, o);
+  }
+  if (!r.has("target")) r.get_double_or("target", 0.0);  // marks an explicit `target: null` as read
   find_algorithm(o.algorithm, r.key_path("algorithm"));
-  o.local_algorithm = r.get_string_or("local_algorithm", o.local_algorithm);
   if (!o.local_algorithm.empty()) find_algorithm(o.local_algorithm, r.key_path("local_algorithm"));
-  o.max_evaluations = r.get_int_or("max_evaluations", o.max_evaluations, Rule::positive());
-  o.max_time_s = r.get_double_or("max_time_s", o.max_time_s, Rule::non_negative());
-  o.max_iterations = r.get_int_or("max_iterations", o.max_iterations, Rule::non_negative());
-  o.xtol_rel = r.get_double_or("xtol_rel", o.xtol_rel, Rule::non_negative());
-  o.ftol_rel = r.get_double_or("ftol_rel", o.ftol_rel, Rule::non_negative());
-  o.ftol_abs = r.get_double_or("ftol_abs", o.ftol_abs, Rule::non_negative());
-  if (r.has("target")) o.target = r.get_double("target");
-  else r.get_double_or("target", 0.0);  // marks an explicit `target: null` as read
-  o.constraint_tolerance = r.get_double_or("constraint_tolerance", o.constraint_tolerance, Rule::non_negative());
-  o.finite_difference = finite_difference_from_string(
-      r.get_choice_or("finite_difference", to_string(o.finite_difference), {"forward", "central"}),
-      r.key_path("finite_difference"));
-  o.fd_relative_step = r.get_double_or("fd_relative_step", o.fd_relative_step, Rule::in_range(0.0, 0.49));
-  o.seed = static_cast<unsigned long>(r.get_int_or("seed", static_cast<long>(o.seed), Rule::non_negative()));
-  o.population = r.get_int_or("population", o.population, Rule::non_negative());
-  o.initial_step = r.get_double_or("initial_step", o.initial_step, Rule::in_range(0.0, 1.0));
-  o.print_level = static_cast<int>(r.get_int_or("print_level", o.print_level, Rule::in_range(0, 12)));
-  o.handle_sigint = r.get_bool_or("handle_sigint", o.handle_sigint);
-  o.keep_history = r.get_bool_or("keep_history", o.keep_history);
   const bool is_sao = find_algorithm(o.algorithm).name == "SAO";
   YamlReader nested = r.child("sao");
   const bool outer = sao_section && sao_section->present();

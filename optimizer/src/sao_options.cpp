@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/common/config_fields.hpp"
 #include "abuopt/optimizer/problem.hpp"
 
 namespace abuopt::opt {
@@ -122,53 +123,74 @@ void SaoOptions::validate(const std::string& p) const {
                                        "central_composite or lhs");
 }
 
+namespace {
+
+// EnumNames (config_fields.hpp) from a spelling list in declaration order.
+template <class E>
+EnumNames<E> enum_names(const std::vector<std::string>& names) {
+  EnumNames<E> out;
+  for (std::size_t i = 0; i < names.size(); ++i) out.emplace_back(static_cast<E>(i), names[i]);
+  return out;
+}
+
+// An override that is absent unless given (written only when set).
+void optional_intervening(FieldArchive& a, const char* key, std::optional<InterveningKind>& v,
+                          InterveningKind fallback) {
+  static const EnumNames<InterveningKind> names = enum_names<InterveningKind>(intervening_kind_names());
+  InterveningKind k = v.value_or(fallback);
+  FieldOptions o;
+  o.enabled = a.reading() || v.has_value();
+  const bool given = a.reading() && a.has(key);
+  a.field(key, k, names, o);
+  if (given) v = k;
+}
+
+}  // namespace
+
+// The keys of a `sao:` section, once (reading, writing, validation of single values). The rules
+// that relate keys (min_radius <= initial_radius, ...) and the friendlier texts are in validate().
+void describe_fields(FieldArchive& a, SaoOptions& o) {
+  static const EnumNames<SurrogateKind> surrogates = enum_names<SurrogateKind>(surrogate_kind_names());
+  static const EnumNames<DoeKind> does = enum_names<DoeKind>(doe_kind_names());
+  static const EnumNames<InterveningKind> forms = enum_names<InterveningKind>(intervening_kind_names());
+  static const EnumNames<SubproblemSolver> solvers = enum_names<SubproblemSolver>(subproblem_solver_names());
+  a.field("surrogate", o.surrogate, surrogates);
+  a.field("doe", o.doe, does);
+  a.field("doe_points", o.doe_points, Rule::in_range(0, 100000));
+  a.field("doe_points_factor", o.doe_points_factor);
+  a.field("reuse_distance", o.reuse_distance);
+  a.field("neighbourhood", o.neighbourhood);
+  a.field("geometry_spread", o.geometry_spread);
+  a.field("initial_radius", o.initial_radius);
+  a.field("min_radius", o.min_radius);
+  a.field("max_radius", o.max_radius);
+  a.field("shrink_factor", o.shrink_factor);
+  a.field("expand_factor", o.expand_factor);
+  a.field("rho_shrink", o.rho_shrink);
+  a.field("rho_expand_low", o.rho_expand_low);
+  a.field("rho_expand_high", o.rho_expand_high);
+  a.field("intervening", o.intervening, forms);
+  optional_intervening(a, "intervening_objective", o.intervening_objective, o.intervening);
+  optional_intervening(a, "intervening_constraints", o.intervening_constraints, o.intervening);
+  a.field("correction", o.correction);
+  a.field("short_step", o.short_step);
+  a.field("noise_tolerance", o.noise_tolerance);
+  a.field("penalty_initial", o.penalty_initial);
+  a.field("penalty_multiplier_factor", o.penalty_multiplier_factor);
+  a.field("stall_iterations", o.stall_iterations, Rule::in_range(1, 1e6));
+  a.field("stall_tolerance", o.stall_tolerance);
+  a.field("subproblem_solver", o.subproblem_solver, solvers);
+  a.field("subproblem_max_evaluations", o.subproblem_max_evaluations, Rule::in_range(10, 1e7));
+  a.field("kriging_nugget", o.kriging_nugget);
+}
+
 SaoOptions read_sao_options(YamlReader& r) {
   SaoOptions o;
-  // the choices: read as text (the reader checks the spelling), parsed once into their enums
-  auto choice = [&r](const std::string& key, const std::string& fallback, const std::vector<std::string>& names) {
-    return r.get_choice_or(key, fallback, names);
-  };
-  o.surrogate = surrogate_kind_from_string(choice("surrogate", to_string(o.surrogate), surrogate_kind_names()),
-                                           r.key_path("surrogate"));
-  o.doe = doe_kind_from_string(choice("doe", to_string(o.doe), doe_kind_names()), r.key_path("doe"));
-  o.doe_points = static_cast<int>(r.get_int_or("doe_points", o.doe_points, Rule::in_range(0, 100000)));
-  o.doe_points_factor = r.get_double_or("doe_points_factor", o.doe_points_factor);
-  o.reuse_distance = r.get_double_or("reuse_distance", o.reuse_distance);
-  o.neighbourhood = r.get_double_or("neighbourhood", o.neighbourhood);
-  o.geometry_spread = r.get_double_or("geometry_spread", o.geometry_spread);
-  o.initial_radius = r.get_double_or("initial_radius", o.initial_radius);
-  o.min_radius = r.get_double_or("min_radius", o.min_radius);
-  o.max_radius = r.get_double_or("max_radius", o.max_radius);
-  o.shrink_factor = r.get_double_or("shrink_factor", o.shrink_factor);
-  o.expand_factor = r.get_double_or("expand_factor", o.expand_factor);
-  o.rho_shrink = r.get_double_or("rho_shrink", o.rho_shrink);
-  o.rho_expand_low = r.get_double_or("rho_expand_low", o.rho_expand_low);
-  o.rho_expand_high = r.get_double_or("rho_expand_high", o.rho_expand_high);
-  o.intervening = intervening_kind_from_string(
-      choice("intervening", to_string(o.intervening), intervening_kind_names()), r.key_path("intervening"));
-  for (const char* key : {"intervening_objective", "intervening_constraints"}) {
-    if (!r.has(key)) continue;
-    const InterveningKind k = intervening_kind_from_string(
-        choice(key, to_string(o.intervening), intervening_kind_names()), r.key_path(key));
-    (std::string(key) == "intervening_objective" ? o.intervening_objective : o.intervening_constraints) = k;
-  }
-  o.correction = r.get_bool_or("correction", o.correction);
-  o.short_step = r.get_double_or("short_step", o.short_step);
-  o.noise_tolerance = r.get_double_or("noise_tolerance", o.noise_tolerance);
-  o.penalty_initial = r.get_double_or("penalty_initial", o.penalty_initial);
-  o.penalty_multiplier_factor = r.get_double_or("penalty_multiplier_factor", o.penalty_multiplier_factor);
-  o.stall_iterations = static_cast<int>(r.get_int_or("stall_iterations", o.stall_iterations, Rule::in_range(1, 1e6)));
-  o.stall_tolerance = r.get_double_or("stall_tolerance", o.stall_tolerance);
-  o.subproblem_solver = subproblem_solver_from_string(
-      choice("subproblem_solver", to_string(o.subproblem_solver), subproblem_solver_names()),
-      r.key_path("subproblem_solver"));
-  o.subproblem_max_evaluations = static_cast<int>(
-      r.get_int_or("subproblem_max_evaluations", o.subproblem_max_evaluations, Rule::in_range(10, 1e7)));
-  o.kriging_nugget = r.get_double_or("kriging_nugget", o.kriging_nugget);
-  r.finish();
+  read_fields(r, o);  // absent keys keep their defaults; unknown keys are errors (finish())
   o.validate(r.path().empty() ? "sao" : r.path());
   return o;
 }
 
+std::string to_yaml(const SaoOptions& o) { return write_fields(o); }
 
 }  // namespace abuopt::opt

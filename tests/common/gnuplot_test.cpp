@@ -62,6 +62,8 @@ bool is_png(const fs::path& p) {
 TEST(Gnuplot, QuotesStringsForGnuplot) {
   EXPECT_EQ(Gnuplot::quote("it's"), "'it''s'");
   EXPECT_EQ(Gnuplot::quote("a_b"), "'a_b'");
+  // No text can end the string or the line: control characters become spaces (issue 12).
+  EXPECT_EQ(Gnuplot::quote("x'\nsystem \"touch y\"\r\t'"), "'x'' system \"touch y\"  '''");
 }
 
 // The script goes beside the CSV, named after the PNG.

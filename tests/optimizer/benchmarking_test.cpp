@@ -148,6 +148,49 @@ TEST(Comparison, RunsEverySolverFromEveryStartAndWritesFiles) {
   std::filesystem::remove_all(dir);
 }
 
+// The runs of a problem are independent: running 1 or 4 at a time gives the same runs, in the
+// same order, evaluation for evaluation (only wall times differ). SAO, COBYLA and AUGLAG(COBYLA) on
+// a smooth and a noisy problem, 5 starts each.
+TEST(Comparison, ResultsDoNotDependOnHowManyRunsAtOnce) {
+  auto setup_with = [](int threads) {
+    opt::ComparisonSetup setup;
+    for (const char* name : {"hs071", "noisy_cantilever"}) {
+      opt::ProblemSpec p;
+      p.label = name;
+      p.make = [name] { return opt::benchmarks::make_benchmark(name); };
+      p.max_evaluations = 120;
+      p.starts = 5;
+      p.seed = 9;
+      setup.problems.push_back(p);
+    }
+    setup.solvers.push_back(opt::solver_spec("SAO", "sao"));
+    setup.solvers.push_back(opt::solver_spec("COBYLA", "cobyla"));
+    setup.solvers.push_back(opt::solver_spec("AUGLAG", "auglag"));
+    setup.solvers.back().options.local_algorithm = "cobyla";
+    setup.threads = threads;
+    std::vector<std::string> order;
+    setup.on_run = [&order](const opt::RunRecord& r) { order.push_back(r.problem + r.solver + std::to_string(r.start)); };
+    opt::ComparisonResult r = opt::run_comparison(setup);
+    return std::make_pair(std::move(r), order);
+  };
+  const auto [serial, serial_order] = setup_with(1);
+  const auto [parallel, parallel_order] = setup_with(4);
+  ASSERT_EQ(serial.runs.size(), 30u);
+  ASSERT_EQ(parallel.runs.size(), serial.runs.size());
+  EXPECT_EQ(parallel_order, serial_order);
+  for (std::size_t i = 0; i < serial.runs.size(); ++i) {
+    const auto& a = serial.runs[i].result;
+    const auto& b = parallel.runs[i].result;
+    EXPECT_EQ(serial.runs[i].solver, parallel.runs[i].solver);
+    EXPECT_EQ(a.evaluations, b.evaluations) << i;
+    EXPECT_EQ(a.x, b.x) << i;
+    EXPECT_EQ(a.objective, b.objective) << i;
+    ASSERT_EQ(a.history.size(), b.history.size()) << i;
+    for (std::size_t k = 0; k < a.history.size(); ++k) EXPECT_EQ(a.history[k].x, b.history[k].x) << i << " " << k;
+    EXPECT_EQ(serial.runs[i].evaluations_to_solve, parallel.runs[i].evaluations_to_solve) << i;
+  }
+}
+
 TEST(Comparison, BadSetupIsAConfigError) {
   opt::ComparisonSetup setup;
   EXPECT_THROW(opt::run_comparison(setup), ConfigError);

@@ -154,3 +154,49 @@ TEST(OptimizerOptions, SaoSettingsFromTheNestedOrAPassedSection) {
 }
 
 }  // namespace
+
+namespace {
+
+// read -> write -> read gives the same options (the one field list serves both), for a config
+// with every key away from its default, SAO settings included.
+TEST(OptimizerOptions, RoundTripThroughTheFieldList) {
+  const OptimizerOptions a = read(
+      "optimizer:\n  algorithm: SAO\n  max_evaluations: 77\n  max_time_s: 12.5\n  max_iterations: 9\n"
+      "  xtol_rel: 1.0e-4\n  ftol_rel: 0\n  ftol_abs: 0.001\n  target: -3.25\n  constraint_tolerance: 1.0e-5\n"
+      "  finite_difference: central\n  fd_relative_step: 0.001\n  seed: 42\n  population: 12\n"
+      "  initial_step: 0.2\n  print_level: 3\n  handle_sigint: false\n  keep_history: false\n"
+      "  sao: {surrogate: kriging, doe: lhs, doe_points: 7, initial_radius: 0.2, max_radius: 0.8,\n"
+      "        intervening: reciprocal, intervening_objective: linear, subproblem_solver: cobyla,\n"
+      "        correction: false, kriging_nugget: 0.01, stall_iterations: 3}\n");
+  const std::string text = to_yaml(a);
+  const OptimizerOptions b = read("optimizer:\n" + [&] {
+    std::string indented;
+    std::size_t start = 0;
+    while (start < text.size()) {
+      const std::size_t end = text.find('\n', start);
+      indented += "  " + text.substr(start, end - start) + "\n";
+      start = end + 1;
+    }
+    return indented;
+  }());
+  EXPECT_EQ(to_yaml(b), text);
+  EXPECT_EQ(b.max_evaluations, 77);
+  EXPECT_EQ(b.target, -3.25);
+  EXPECT_EQ(b.finite_difference, FiniteDifference::Central);
+  EXPECT_EQ(b.seed, 42u);
+  EXPECT_FALSE(b.keep_history);
+  EXPECT_EQ(b.sao.surrogate, SurrogateKind::Kriging);
+  EXPECT_EQ(b.sao.doe_points, 7);
+  EXPECT_EQ(b.sao.intervening, InterveningKind::Reciprocal);
+  EXPECT_EQ(b.sao.intervening_objective, InterveningKind::Linear);
+  EXPECT_FALSE(b.sao.intervening_constraints.has_value());
+  EXPECT_EQ(b.sao.subproblem_solver, SubproblemSolver::Cobyla);
+  EXPECT_FALSE(b.sao.correction);
+  EXPECT_EQ(b.sao.kriging_nugget, 0.01);
+  // the defaults round-trip too, and a non-SAO algorithm writes no sao section
+  const OptimizerOptions d;
+  EXPECT_EQ(to_yaml(d).find("sao"), std::string::npos);
+  EXPECT_NE(to_yaml(d).find("algorithm: cobyla"), std::string::npos);
+}
+
+}  // namespace

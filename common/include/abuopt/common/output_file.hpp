@@ -4,6 +4,7 @@
 //   write_file_atomic(path, text)   writes <path>.tmp-<pid>-<n> in the same folder, checks every
 //                                   write, flush and close, then renames it to `path`; on failure
 //                                   the temporary is removed and `path` keeps its old content.
+//                                   A device or FIFO (/dev/null, /dev/stdout) is written in place.
 //   AtomicFile f(path); f.stream() << ...; f.commit();   the same for files built piece by piece
 //                                   (destroyed without commit(): the temporary is removed).
 //   OutputDirLock lock(dir);        one abuopt run per output folder (flock on <dir>/.abuopt.lock,
@@ -34,6 +35,11 @@ class AtomicFile {
   AtomicFile& operator=(const AtomicFile&) = delete;
 
   std::ostream& stream() { return buffer_; }
+  template <class T>
+  AtomicFile& operator<<(const T& v) {
+    buffer_ << v;
+    return *this;
+  }
   const std::filesystem::path& path() const { return path_; }
   // Writes the collected text to the final name (write_file_atomic). Throws OutputError.
   void commit();

@@ -75,8 +75,12 @@ struct ComparisonSetup {
   std::vector<SolverSpec> solvers;
   double tau = 1e-2;  // accuracy of "solved" (relative, see above), in (0, 1)
   std::string true_objective_metric = "noise_free_objective";
-  // Called after each run (e.g. to print progress); may be empty.
+  // Called after each run (e.g. to print progress), in run order; may be empty.
   std::function<void(const RunRecord&)> on_run;
+  // Runs of one problem at once (its starts x solvers are independent); the results do not
+  // depend on it (only wall times do). 1: one after another. Each run's own Monte Carlo threads
+  // come on top, so for the startup problem keep threads x montecarlo.threads near the cores.
+  int threads = 1;
 };
 
 // One point of a convergence curve: after `evaluation` evaluations the best feasible true

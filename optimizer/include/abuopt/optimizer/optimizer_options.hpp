@@ -90,4 +90,10 @@ struct OptimizerOptions {
 // (finish() is called on it too); giving both, or either with another algorithm, is an error.
 OptimizerOptions read_optimizer_options(YamlReader& section, YamlReader* sao_section = nullptr);
 
+// The one field list of the `optimizer:` section (config_fields.hpp), `sao` nested when the
+// algorithm is SAO (reading it is read_optimizer_options' job: it may come from two places).
+void describe_fields(FieldArchive& a, OptimizerOptions& o);
+// The section as YAML (read_optimizer_options of it gives the same options).
+std::string to_yaml(const OptimizerOptions& o);
+
 }  // namespace abuopt::opt

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "abuopt/common/config_fields.hpp"
 #include "abuopt/common/yaml_reader.hpp"
 
 namespace abuopt::opt {
@@ -135,8 +136,14 @@ struct SaoOptions {
   void validate(const std::string& prefix = "sao") const;
 };
 
+// The one field list of the `sao:` section (config_fields.hpp): reading, writing and the single-
+// value rules come from it; validate() adds the rules that relate keys.
+void describe_fields(FieldArchive& a, SaoOptions& o);
+
 // Reads the keys of a `sao:` section (pass root.child("sao")); absent keys keep their defaults,
 // unknown keys are errors (finish() is called), then validate().
 SaoOptions read_sao_options(YamlReader& section);
+// The section as YAML (every key; read_sao_options of it gives the same options).
+std::string to_yaml(const SaoOptions& o);
 
 }  // namespace abuopt::opt

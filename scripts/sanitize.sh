@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# Sanitizer and fuzz steps of CI (called by scripts/test.sh; docs/testing.md has the measured times).
+#   asan:  ASan + UBSan (-fno-sanitize-recover=all, asserts on) build of the libraries and their
+#          unit tests, runs the default suite without the command-line tests (ctest -LE long).
+#   tsan:  ThreadSanitizer build of the threaded tests only (Monte Carlo engine, optimiser
+#          evaluation archive and minimize, the startup-profile problem).
+#   fuzz:  libFuzzer targets (clang) built with ASan + UBSan, each run for ABUOPT_FUZZ_SECONDS
+#          (default 10) from the seed corpus made from configs/ (scripts/fuzz.sh).
+# Usage: scripts/sanitize.sh [asan] [tsan] [fuzz]   (no argument: all three)
+# Every step prints "sanitize: <step> <seconds> s"; a finding fails the step (exit status != 0).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+jobs=$(nproc 2>/dev/null || echo 2)
+steps=("$@")
+[ ${#steps[@]} -eq 0 ] && steps=(asan tsan fuzz)
+
+timed() {
+  local name=$1
+  shift
+  local t0=$SECONDS
+  "$@"
+  echo "sanitize: $name $((SECONDS - t0)) s"
+}
+
+# The tests only: no benchmarks. -O1 keeps the build and the run fast enough for CI.
+configure() {
+  local dir=$1 flags=$2
+  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DABUOPT_BUILD_BENCH=OFF \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g -fno-omit-frame-pointer $flags" \
+    -DCMAKE_EXE_LINKER_FLAGS="$flags" >/dev/null
+}
+
+# Every unit test of the libraries (common, core, surrogate, optimizer, problems, studies). The
+# command-line tests (tests/app) are left out: they run whole studies through the binary (minutes
+# under ASan) and their input parsing is fuzzed under ASan by fuzz_cli.
+asan_targets() {
+  grep -h "abuopt_add_test(" tests/*/CMakeLists.txt | grep -v "LABELS long" |
+    sed -E 's/^abuopt_add_test\(([a-z_0-9]+).*/\1/' | grep -v "^#" |
+    grep -v -x -E "simulate_cli_test|reproduce_test|optimize_cli_test|compare_cli_test"
+}
+asan_build() {
+  configure build-asan "-fsanitize=address,undefined -fno-sanitize-recover=all"
+  # shellcheck disable=SC2046
+  cmake --build build-asan -j "$jobs" --target $(asan_targets)
+}
+asan_test() {
+  ASAN_OPTIONS=detect_leaks=1:strict_string_checks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    ctest --test-dir build-asan -LE long -E "_NOT_BUILT$|^(SimulateCli|ReproduceCli|OptimizeCli|CompareCli)[.]" \
+    --output-on-failure -j "$jobs"
+}
+
+tsan_targets=(monte_carlo_test evaluation_archive_test minimize_test startup_profile_problem_test)
+tsan_build() {
+  configure build-tsan "-fsanitize=thread"
+  cmake --build build-tsan -j "$jobs" --target "${tsan_targets[@]}"
+}
+tsan_test() {
+  # setarch -R: kernels with 28+ bits of mmap randomisation break TSan's memory layout
+  # ("unexpected memory mapping"); without address randomisation it runs.
+  local regex="^(MonteCarlo|EvaluationArchive|ArchivedProblem|Minimize|StartupProfileProblem)"
+  TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 \
+    setarch "$(uname -m)" -R ctest --test-dir build-tsan -LE long -R "$regex" -E "_NOT_BUILT$" \
+    --output-on-failure -j "$jobs"
+}
+
+for s in "${steps[@]}"; do
+  case "$s" in
+    asan) timed asan-build asan_build; timed asan-test asan_test ;;
+    tsan) timed tsan-build tsan_build; timed tsan-test tsan_test ;;
+    fuzz) timed fuzz bash scripts/fuzz.sh ;;
+    *) echo "sanitize: unknown step '$s' (asan, tsan, fuzz)" >&2; exit 2 ;;
+  esac
+done

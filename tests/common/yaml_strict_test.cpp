@@ -1,0 +1,86 @@
+// The reader refuses what it would otherwise silently half-read (issue 12): a key given twice in
+// one mapping (the first won), a second YAML document (ignored), a directory as the config file.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "abuopt/common/config_error.hpp"
+#include "abuopt/common/yaml_reader.hpp"
+
+namespace abuopt {
+namespace {
+
+std::string error_of(const std::string& text) {
+  try {
+    YamlReader::load_string(text, "t");
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(YamlStrict, ADuplicateKeyIsAnErrorNamingIt) {
+  const std::string m = error_of("abu:\n  friction_mu: 0.02\n  friction_mu: 0.5\n");
+  EXPECT_NE(m.find("abu.friction_mu"), std::string::npos) << m;
+  EXPECT_NE(m.find("appears twice"), std::string::npos) << m;
+  EXPECT_NE(m.find("line 3"), std::string::npos) << m;
+}
+
+TEST(YamlStrict, ADuplicateSectionIsAnError) {
+  const std::string m = error_of("abu:\n  friction_mu: 0.02\nabu:\n  friction_mu: 0.5\n");
+  EXPECT_NE(m.find("abu = "), std::string::npos) << m;
+  EXPECT_NE(m.find("appears twice"), std::string::npos) << m;
+}
+
+TEST(YamlStrict, DuplicatesInsideListsAreFoundToo) {
+  const std::string m = error_of("profile:\n  segments:\n    - {end_frequency_hz: 5, end_frequency_hz: 6}\n");
+  EXPECT_NE(m.find("profile.segments[0].end_frequency_hz"), std::string::npos) << m;
+}
+
+TEST(YamlStrict, ASecondDocumentIsAnError) {
+  const std::string m = error_of("abu:\n  friction_mu: 0.02\n---\nabu:\n  friction_mu: 0.5\n");
+  EXPECT_NE(m.find("2 YAML documents"), std::string::npos) << m;
+  EXPECT_EQ(error_of("abu:\n  friction_mu: 0.02\n"), "");
+}
+
+TEST(YamlStrict, TheFileIsNamedAndADirectoryIsBadInput) {
+  const std::string file = std::string(ABUOPT_BINARY_DIR) + "/yaml_strict_test.yaml";
+  {
+    std::ofstream f(file);
+    f << "a: 1\nb: 2\na: 3\n";
+  }
+  try {
+    YamlReader::load_file(file);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find(file), std::string::npos) << m;
+    EXPECT_NE(m.find("a = 3"), std::string::npos) << m;
+  }
+  std::filesystem::remove(file);
+  try {
+    YamlReader::load_file(ABUOPT_BINARY_DIR);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
+  }
+}
+
+TEST(YamlStrict, StringListsAndTheDeepMerge) {
+  YamlReader r = YamlReader::load_string("one: a\nmany: [b, c]\nbad: [x, [y]]\n");
+  EXPECT_EQ(r.get_string_list_or("one"), std::vector<std::string>{"a"});
+  EXPECT_EQ(r.get_string_list_or("many"), (std::vector<std::string>{"b", "c"}));
+  EXPECT_EQ(r.get_string_list_or("absent", {"z"}), std::vector<std::string>{"z"});
+  EXPECT_THROW(r.get_string_list_or("bad"), ConfigError);
+  const YAML::Node base = YAML::Load("a: {x: 1, y: 2}\nb: [1, 2]\n");
+  const YAML::Node merged = merge_yaml(base, YAML::Load("a: {y: 3}\nb: [9]\n"));
+  EXPECT_EQ(merged["a"]["x"].as<int>(), 1);  // maps merge key by key
+  EXPECT_EQ(merged["a"]["y"].as<int>(), 3);
+  EXPECT_EQ(merged["b"].size(), 1u);  // sequences replace
+  EXPECT_EQ(base["a"]["y"].as<int>(), 2);  // the base is not modified
+}
+
+}  // namespace
+}  // namespace abuopt
