@@ -52,6 +52,30 @@ void BM_FinalProfileRun_Arkode(benchmark::State& state) { run_profile(state, abu
 BENCHMARK(BM_FinalProfileRun_Native)->Arg(6)->Arg(8)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FinalProfileRun_Arkode)->Arg(6)->Unit(benchmark::kMillisecond)->Iterations(32);
 
+// Ball contact: the same 16 starts (mapped onto the feasible set by the simulator when they
+// overlap), contact none vs hard, in one program run so the ratio is measured under one load.
+void run_contact(benchmark::State& state, abuopt::BallContact contact) {
+  abuopt::SimulationSetup s = final_profile(abuopt::IntegratorBackend::Native, 1e-6);
+  s.abu.ball_contact = contact;
+  abuopt::Simulator sim(s);
+  const auto ics = fixed_initial_conditions();
+  std::size_t k = 0;
+  double events = 0, impacts = 0, runs = 0;
+  for (auto _ : state) {
+    const auto o = sim.run(ics[k++ % ics.size()]);
+    benchmark::DoNotOptimize(o.residual_imbalance_kgm);
+    events += static_cast<double>(o.events);
+    impacts += static_cast<double>(o.impacts);
+    runs += 1;
+  }
+  state.counters["events_per_run"] = events / runs;
+  state.counters["impacts_per_run"] = impacts / runs;
+}
+void BM_FinalProfileRun_ContactNone(benchmark::State& state) { run_contact(state, abuopt::BallContact::None); }
+void BM_FinalProfileRun_ContactHard(benchmark::State& state) { run_contact(state, abuopt::BallContact::Hard); }
+BENCHMARK(BM_FinalProfileRun_ContactNone)->Unit(benchmark::kMillisecond)->Iterations(160);
+BENCHMARK(BM_FinalProfileRun_ContactHard)->Unit(benchmark::kMillisecond)->Iterations(160);
+
 void BM_RhsEvaluation(benchmark::State& state) {
   abuopt::AbuParameters p;
   abuopt::AbuModel model(abuopt::NondimParameters::from(p));

@@ -9,9 +9,9 @@
 #include <nlohmann/json.hpp>
 
 #include "abuopt/common/config_error.hpp"
-#include "abuopt/core/monte_carlo.hpp"
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/text.hpp"
+#include "abuopt/core/monte_carlo.hpp"
 #include "abuopt/core/simulation_config.hpp"
 #include "abuopt/core/simulator.hpp"
 #include "commands/commands.hpp"

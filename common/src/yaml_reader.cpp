@@ -275,7 +275,9 @@ std::vector<YamlReader> YamlReader::children(const std::string& key) {
 void YamlReader::finish() const {
   if (!present()) return;
   for (auto it = node_.begin(); it != node_.end(); ++it) {
-    const std::string k = it->first.as<std::string>();
+    // A key that is not a scalar ({[a, b]: 1}) is never a known key; as<std::string>() would throw
+    // YAML's own exception (an internal error instead of a config error).
+    const std::string k = it->first.IsScalar() ? it->first.Scalar() : yaml_value_text(it->first);
     if (!read_.count(k)) {
       throw ConfigError(key_path(k), yaml_value_text(it->second), "unknown key (misspelt, or not valid here)");
     }

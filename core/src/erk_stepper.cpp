@@ -198,6 +198,19 @@ ErkStepper::Status ErkStepper::step() {
     g0_.swap(g1_);
     return t_ >= tstop_ ? StopReached : Ok;
   }
+  if (polish_) {
+    // every function that crossed over the step, refined on the RK solution; earliest wins
+    troot = t_ + 1.0;
+    for (std::size_t k = 0; k < nroots_; ++k) {
+      const double a = g0_[k], b = g1_[k];
+      if (a == 0.0 || !((a < 0) != (b < 0) || b == 0.0)) continue;
+      const double tk = polish(k, tprev_, a, t_, b);
+      if (tk < troot) {
+        troot = tk;
+        first = static_cast<int>(k);
+      }
+    }
+  }
   // Recompute the state at the root with a fresh RK step from the step's start.
   const double hroot = troot - tprev_;
   if (hroot > 0) {
@@ -217,6 +230,30 @@ ErkStepper::Status ErkStepper::step() {
     if (a != 0.0 && ((a < 0) != (b < 0) || b == 0.0)) found_[k] = 1;
   }
   return Root;  // the caller resets the stepper at the root
+}
+
+double ErkStepper::polish(std::size_t k, double ta, double ga, double tb, double gb) {
+  int side = 0;
+  for (int it = 0; it < 100 && std::fabs(tb - ta) > 4e-16 * std::max(1.0, std::fabs(tb)); ++it) {
+    double tc = (gb != ga) ? tb - gb * (tb - ta) / (gb - ga) : 0.5 * (ta + tb);
+    if (!(tc > ta && tc < tb)) tc = 0.5 * (ta + tb);
+    attempt(tprev_, yprev_.data(), fprev_.data(), tc - tprev_, ynew_.data());
+    g_(tc, ynew_.data(), gtmp_.data(), user_);
+    const double gc = gtmp_[k];
+    if (gc == 0.0) return tc;
+    if ((gc < 0) == (gb < 0)) {
+      tb = tc;
+      gb = gc;
+      if (side == -1) ga *= 0.5;
+      side = -1;
+    } else {
+      ta = tc;
+      ga = gc;
+      if (side == 1) gb *= 0.5;
+      side = 1;
+    }
+  }
+  return tb;  // on the far side of the crossing
 }
 
 void ErkStepper::dense(double t, double* out) const {

@@ -40,6 +40,11 @@ class ErkStepper {
   // Restarts at (t, y); keeps the current step size as the first guess.
   void reset(double t, const double* y);
   void set_stop_time(double t) { tstop_ = t; }
+  // Polished roots: each crossing found on the interpolant is refined on the Runge-Kutta solution
+  // itself (Illinois, one fresh step from the step's start per iteration), so root times get the
+  // method's accuracy instead of the interpolant's, and the earliest crossing wins. Off by
+  // default (the no-contact model keeps its published numbers); on for hard ball contact.
+  void set_polish_roots(bool on) { polish_ = on; }
   // Takes one accepted step (never past the stop time). On Root, t()/y() are at the earliest
   // root and roots_found()[k] != 0 marks the functions that crossed there.
   Status step();
@@ -54,6 +59,9 @@ class ErkStepper {
  private:
   // One RK step of size h from (t0, y0, f0): high-order result into yout, error norm returned.
   double attempt(double t0, const double* y0, const double* f0, double h, double* yout);
+  // Root of g_k in [ta, tb] (g_k(ta) = ga, g_k(tb) = gb of opposite signs) on RK steps from tprev.
+  double polish(std::size_t k, double ta, double ga, double tb, double gb);
+  bool polish_ = false;
   double initial_step() ;
 
   ButcherTable tab_;

@@ -37,7 +37,10 @@ int rhs_arkode(sunrealtype tbar, N_Vector yv, N_Vector ydotv, void* user) {
 }
 
 int roots_arkode(sunrealtype tbar, N_Vector yv, sunrealtype* g, void* user) {
-  roots_plain(tbar, N_VGetArrayPointer(yv), g, user);
+  if (static_cast<RunState*>(user)->contact)
+    roots_contact(tbar, N_VGetArrayPointer(yv), g, user);
+  else
+    roots_plain(tbar, N_VGetArrayPointer(yv), g, user);
   return 0;
 }
 
@@ -76,7 +79,7 @@ struct ErkStepFree {
 // return code is checked: setup failures throw, failures while stepping end the run with a status.
 class ArkodeIntegrator final : public Integrator {
  public:
-  ArkodeIntegrator(RunState& rs, std::size_t nvar, bool with_roots) : nvar_(nvar), nroots_(with_roots ? 2 * rs.n : 0) {
+  ArkodeIntegrator(RunState& rs, std::size_t nvar, bool with_roots) : nvar_(nvar), nroots_(with_roots ? rs.nroots() : 0) {
     SUNContext ctx = nullptr;
     check(SUNContext_Create(nullptr, &ctx), "SUNContext_Create");
     ctx_.reset(check_ptr(ctx, "SUNContext_Create"));

@@ -13,8 +13,10 @@ namespace {
 class NativeIntegrator final : public Integrator {
  public:
   NativeIntegrator(RunState& rs, std::size_t nvar, bool with_roots)
-      : st_(table_for(rs.opt.erk_table), nvar, rhs_plain, with_roots ? roots_plain : nullptr,
-            with_roots ? 2 * rs.n : 0, &rs, rs.opt.rtol, rs.opt.atol, rs.opt.max_steps) {}
+      : st_(table_for(rs.opt.erk_table), nvar, rhs_plain,
+            with_roots ? (rs.contact ? roots_contact : roots_plain) : nullptr, with_roots ? rs.nroots() : 0, &rs, rs.opt.rtol, rs.opt.atol, rs.opt.max_steps) {
+    st_.set_polish_roots(rs.contact);  // contact events need exact times (docs/model.md 11.5)
+  }
   void reset(double t, const std::vector<double>& y) override { st_.reset(t, y.data()); }
   void set_stop(double t) override { st_.set_stop_time(t); }
   Result step(double& t, std::vector<double>& y, std::vector<int>& roots) override {

@@ -7,6 +7,7 @@
 #include <numeric>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/core/ball_contact.hpp"
 
 namespace abuopt {
 
@@ -15,7 +16,11 @@ namespace {
 MonteCarloSample make_sample(const MonteCarloStudy& s, std::size_t index, std::vector<double> beta0) {
   MonteCarloSample out;
   out.index = index;
-  out.beta0 = std::move(beta0);
+  // With hard ball contact every design point is mapped onto the feasible set (no overlapping
+  // start; docs/model.md 11.6): a deterministic map, so a run stays replayable from (seed, index).
+  out.beta0 = s.setup.abu.ball_contact == BallContact::Hard && beta0.size() >= 2
+                  ? map_onto_contact_feasible_set(s.setup.abu, beta0)
+                  : std::move(beta0);
   out.overrides = sample_overrides(s.uncertain, s.setup.abu, s.seed, index);
   out.friction_mu = out.overrides.friction_mu.value_or(s.setup.abu.friction_mu);
   out.imbalance_kgm =

@@ -14,7 +14,7 @@ namespace abuopt::detail {
 Speed evaluate_forces(RunState& rs, double tbar, const double* y) {
   if (!rs.pi_motor) {
     const Speed sp = ideal_speed(rs, tbar);
-    rs.model.evaluate(y, sp.W, sp.Wp, rs.modes.data(), rs.mu, rs.forces);
+    rs.eval(y, sp.W, sp.Wp);
     return sp;
   }
   // PI motor: states delta = theta_ref - theta [rad] and W (StateLayout::motor_delta/motor_speed).
@@ -29,7 +29,7 @@ Speed evaluate_forces(RunState& rs, double tbar, const double* y) {
   const double accel0 = 2.0 * rs.motor.xi * wm * (Omega_ref - Omega) + wm * wm * delta + load / rs.motor.inertia_kgm2;
   const double w2 = rs.omega_n * rs.omega_n;
   double Wp = accel0 / w2;
-  rs.model.evaluate(y, W, Wp, rs.modes.data(), rs.mu, rs.forces);
+  rs.eval(y, W, Wp);
   if (rs.motor.friction_feedback) {
     const double L = rs.params.ball_track_radius_m;
     for (int pass = 0; pass < 2; ++pass) {
@@ -37,7 +37,7 @@ Speed evaluate_forces(RunState& rs, double tbar, const double* y) {
       for (std::size_t i = 0; i < rs.n; ++i)
         torque += (rs.forces.fw[i] + rs.nd.cbar[i] * y[rs.lay().beta_dot(i)]) * rs.params.balls[i].mass_kg * w2 * L * L;
       Wp = (accel0 + torque / rs.motor.inertia_kgm2) / w2;
-      rs.model.evaluate(y, W, Wp, rs.modes.data(), rs.mu, rs.forces);
+      rs.eval(y, W, Wp);
     }
   }
   return {W, Wp};
@@ -110,6 +110,10 @@ void roots_plain(double tbar, const double* y, double* g, void* user) {
 
 // Shifts the stick margins that start negative (by rounding) so their crossing is still seen.
 void set_root_offsets(RunState& rs, double tbar, const double* y) {
+  if (rs.contact) {
+    set_contact_root_offsets(rs, tbar, y);
+    return;
+  }
   evaluate_forces(rs, tbar, y);
   for (std::size_t i = 0; i < rs.n; ++i) {
     rs.off_a[i] = rs.off_b[i] = 0;

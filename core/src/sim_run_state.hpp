@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "abuopt/core/abu_model.hpp"
+#include "abuopt/core/ball_contact.hpp"
 #include "abuopt/core/simulator.hpp"
 
 namespace abuopt::detail {
@@ -18,6 +19,19 @@ inline double wrap_angle(double a) {
   if (r >= kTwoPi) r = 0;
   return r;
 }
+
+// Hard ball-ball contact of one run (docs/model.md section 11; sim_contact.cpp).
+struct ContactState {
+  ContactGeometry geo;        // cyclic order and least spacings (fixed for the run)
+  std::vector<char> closed;   // per neighbour pair: the two balls move as one cluster
+  Clusters clusters;          // built from `closed`
+  std::vector<int> group_of;  // ball -> cluster index
+  std::vector<double> off_gap, off_lambda;  // root offsets (see set_root_offsets)
+  double restitution = 0;
+  double v_stop = 0;          // relative approach speed below which an impact is plastic
+  long impacts = 0;
+  double max_correction = 0;  // largest position correction of a negative gap at an event [rad]
+};
 
 // Everything one run needs; ARKODE's user data.
 struct RunState {
@@ -46,8 +60,19 @@ struct RunState {
   // integration (simulator.cpp), so no step straddles a jump of the right-hand side.
   bool ref_held = false;
   double ref_hold_hz = 0;
+  bool contact = false;  // hard ball-ball contact (two or more balls)
+  ContactState cs;
 
   const StateLayout& lay() const { return model.layout(); }
+  // Root functions: two per ball; with contact one more per neighbour pair (the gaps).
+  std::size_t nroots() const { return 2 * n + (contact ? cs.geo.pairs() : 0); }
+  // The model's forces for the current modes (and clusters, with contact).
+  void eval(const double* y, double W, double Wp) {
+    if (contact)
+      model.evaluate_clusters(y, W, Wp, modes.data(), cs.clusters, mu, forces);
+    else
+      model.evaluate(y, W, Wp, modes.data(), mu, forces);
+  }
 
   explicit RunState(const AbuParameters& p) : params(p), nd(NondimParameters::from(p)), model(nd) {}
 
@@ -88,6 +113,19 @@ void roots_plain(double tbar, const double* y, double* g, void* user);
 // Shifts the stick margins that start negative (by rounding) so their crossing is still seen.
 void set_root_offsets(RunState& rs, double tbar, const double* y);
 bool all_stuck(const RunState& rs, const double* y);
+
+// Hard contact (sim_contact.cpp): setup at the start of a run, root functions, root offsets, and
+// the event step (impacts, then one consistent choice of clusters and modes).
+void contact_setup(RunState& rs, const double* y);
+void roots_contact(double tbar, const double* y, double* g, void* user);
+void set_contact_root_offsets(RunState& rs, double tbar, const double* y);
+// Chooses clusters and modes at an instant: balls at zero relative speed and zero gap may form or
+// leave clusters, clusters at zero speed may stick or slip. forced[g] != 0: cluster g of the
+// current clustering was stuck and one of its margins crossed zero (it must not stay stuck whole).
+void choose_contact_modes(RunState& rs, double W, double Wp, std::vector<double>& y, const std::vector<char>& forced);
+// Applies the roots found at an event: impacts for closing gaps, zero speed for clusters that
+// stopped; then choose_contact_modes. Returns the number of impacts.
+int handle_contact_event(RunState& rs, double tbar, std::vector<double>& y, const std::vector<int>& rinfo);
 // After the profile, with every ball stuck and an ideal motor: finishes the run in closed form
 // when a bound proves no ball can slip again (closed_form_tail.cpp).
 bool closed_form_tail(RunState& rs, double tbar, std::vector<double>& y, double tbar_end, double& peak_amp);

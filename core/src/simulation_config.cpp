@@ -1,5 +1,6 @@
 #include "abuopt/core/simulation_config.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace abuopt {
@@ -7,6 +8,7 @@ namespace abuopt {
 const EnumNames<MotorKind> kMotorKindNames = {{MotorKind::Ideal, "ideal"}, {MotorKind::PI, "pi"}};
 const EnumNames<FrictionMethod> kFrictionMethodNames = {{FrictionMethod::EventDriven, "event_driven"},
                                                         {FrictionMethod::SwitchModel, "switch_model"}};
+const EnumNames<BallContact> kBallContactNames = {{BallContact::None, "none"}, {BallContact::Hard, "hard"}};
 const EnumNames<IntegratorBackend> kIntegratorNames = {{IntegratorBackend::Native, "native"},
                                                        {IntegratorBackend::ArkodeErk, "arkode_erk"}};
 
@@ -36,6 +38,20 @@ void check_balls_fit(const AbuParameters& p, const std::string& path) {
                             ")");
     }
   }
+  if (p.ball_contact == BallContact::Hard && p.balls.size() > 1) {
+    // with contact the balls must also fit side by side: sum of the neighbour spacings < 2 pi
+    double need = 0;
+    for (std::size_t i = 0; i < p.balls.size(); ++i) {
+      const double s = (p.balls[i].diameter_m + p.balls[(i + 1) % p.balls.size()].diameter_m) /
+                       (4.0 * p.ball_track_radius_m);
+      need += 2.0 * std::asin(std::min(1.0, s));
+    }
+    if (!(need < 2.0 * M_PI))
+      throw ConfigError((path.empty() ? "" : path + ".") + "ball_contact", "hard",
+                        "the " + std::to_string(p.balls.size()) +
+                            " balls do not fit side by side on the track (they need " + format_shortest(need) +
+                            " rad of the 2 pi)");
+  }
 }
 
 // "must be >= 0 (0: twice the profile duration)"
@@ -62,6 +78,8 @@ void describe_fields(FieldArchive& a, AbuParameters& p) {
   a.field("eccentricity_m", p.eccentricity_m, Rule::non_negative());
   a.field("friction_mu", p.friction_mu, Rule::in_range(0.0, 0.999));
   a.field("ball_damping_Nms", p.ball_damping_Nms, Rule::non_negative());
+  a.field("ball_contact", p.ball_contact, kBallContactNames);
+  a.field("ball_restitution", p.ball_restitution, Rule::in_range(0.0, 1.0));
   a.items("balls", p.balls);
   if (a.mode() == FieldArchive::Mode::Read || a.mode() == FieldArchive::Mode::Validate) {
     if (p.balls.size() > 64)  // the same limit as ball_count: run time grows with the square of the count

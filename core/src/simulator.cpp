@@ -58,6 +58,9 @@ Simulator::Simulator(SimulationSetup setup) : setup_(std::move(setup)) {
   if (end_time_s() <= 0)
     throw ConfigError("simulation.end_time_s", std::to_string(o.end_time_s),
                       "must be > 0 when the profile has no segments");
+  if (setup_.abu.ball_contact == BallContact::Hard && o.method != FrictionMethod::EventDriven)
+    throw ConfigError("abu.ball_contact", "hard",
+                      "needs simulation.method = event_driven (the switch model has no contact events)");
 }
 
 Simulator::~Simulator() = default;
@@ -106,6 +109,16 @@ class Run {
     y_.assign(nvar_, 0.0);
     // Angles relative to the imbalance; an imbalance at angle phi sees the balls at beta - phi.
     for (std::size_t i = 0; i < rs_.n; ++i) y_[lay_.beta(i)] = wrap_angle(beta0[i] - ov.imbalance_angle_rad);
+    rs_.contact = p_.ball_contact == BallContact::Hard && rs_.n >= 2;
+    if (rs_.contact) {
+      // overlapping starts are mapped onto the feasible set (designs do this already)
+      std::vector<double> b(beta0);
+      if (min_contact_clearance(p_, b) < -1e-12) {
+        b = map_onto_contact_feasible_set(p_, b);
+        for (std::size_t i = 0; i < rs_.n; ++i) y_[lay_.beta(i)] = wrap_angle(b[i] - ov.imbalance_angle_rad);
+      }
+      contact_setup(rs_, y_.data());
+    }
     choose_initial_modes();
   }
 
@@ -119,6 +132,7 @@ class Run {
   }
   void choose_initial_modes();
   bool handle_event(double t);  // false: a guard ended the run (status set)
+  bool count_event(double t);
   void track_all_stuck(double t) {
     if (all_stuck(rs_, y_.data())) {
       if (all_stuck_since_ < 0) all_stuck_since_ = t;
@@ -173,7 +187,10 @@ void Run::reference_step(double t) {
   for (std::size_t i = 0; i < rs_.n; ++i)
     if (rs_.modes[i] == BallMode::Stick) y_[lay_.beta_dot(i)] = 0.0;
   const Speed sp = evaluate_forces(rs_, t, y_.data());
-  rs_.model.choose_modes(y_.data(), sp.W, sp.Wp, rs_.mu, 0.0, rs_.modes.data(), rs_.forces);
+  if (rs_.contact)
+    choose_contact_modes(rs_, sp.W, sp.Wp, y_, std::vector<char>(rs_.n, 0));
+  else
+    rs_.model.choose_modes(y_.data(), sp.W, sp.Wp, rs_.mu, 0.0, rs_.modes.data(), rs_.forces);
   rs_.modes_changed(y_.data());
   if (rs_.modes != before) ++out_.events;
   track_all_stuck(t);
@@ -196,7 +213,10 @@ void Run::choose_initial_modes() {
     rs_.modes.assign(rs_.n, BallMode::Stick);
     sp.Wp = evaluate_forces(rs_, tiny, yprobe.data()).Wp;
   }
-  rs_.model.choose_modes(yprobe.data(), sp.W, sp.Wp, rs_.mu, 0.0, rs_.modes.data(), rs_.forces);
+  if (rs_.contact)
+    choose_contact_modes(rs_, sp.W, sp.Wp, yprobe, std::vector<char>(rs_.n, 0));
+  else
+    rs_.model.choose_modes(yprobe.data(), sp.W, sp.Wp, rs_.mu, 0.0, rs_.modes.data(), rs_.forces);
   rs_.modes_changed(y_.data());
 }
 
@@ -219,6 +239,11 @@ bool Run::handle_event(double t) {
   // whose friction margin reached zero leaves stick in the direction of the force needed to
   // hold it (the net force); the others are re-chosen consistently with that.
   std::vector<double>& y = y_;
+  if (rs_.contact) {
+    out_.impacts += handle_contact_event(rs_, t, y, rinfo_);
+    rs_.modes_changed(y.data());
+    return count_event(t);
+  }
   const Speed sp0 = evaluate_forces(rs_, t, y.data());
   for (std::size_t i = 0; i < rs_.n; ++i) {
     fixed_[i] = 0;
@@ -235,6 +260,11 @@ bool Run::handle_event(double t) {
   const Speed sp = rs_.pi_motor ? sp0 : ideal_speed(rs_, t);
   rs_.model.choose_modes(y.data(), sp.W, sp.Wp, rs_.mu, 0.0, rs_.modes.data(), rs_.forces, &fixed_);
   rs_.modes_changed(y.data());
+  return count_event(t);
+}
+
+// Counts an event and applies the guards (chatter, event budget); tracks the all-stuck period.
+bool Run::count_event(double t) {
   ++out_.events;
   recent_events_.push_back(t);
   while (!recent_events_.empty() && (t - recent_events_.front()) > rs_.opt.chatter_window_s * w_)
@@ -259,6 +289,9 @@ RunOutcome Run::execute() {
   Integrator& integ = *integ_ptr;
   std::vector<double>& y = y_;
   double t = 0;
+  // with contact the offsets go first: reset() evaluates the root functions (a gap shifted after
+  // that would start negative and its crossing would never be seen)
+  if (rs_.contact) set_root_offsets(rs_, t, y.data());
   integ.reset(t, y);
   if (event_driven_) set_root_offsets(rs_, t, y.data());
 
@@ -275,7 +308,7 @@ RunOutcome Run::execute() {
   std::size_t next_break = 0;
   integ.set_stop(breaks[0]);
 
-  rinfo_.assign(2 * rs_.n, 0);
+  rinfo_.assign(rs_.nroots(), 0);
   fixed_.assign(rs_.n, 0);
   all_stuck_since_ = all_stuck(rs_, y.data()) ? 0.0 : -1.0;
   double next_tail_check = t_profile_;
@@ -333,6 +366,7 @@ RunOutcome Run::execute() {
       next_tail_check = t + 0.5 * w_;  // the transient decays; try again later
     }
     if (reset_needed) {
+      if (rs_.contact) set_root_offsets(rs_, t, y.data());
       integ.reset(t, y);
       set_root_offsets(rs_, t, y.data());
     }
@@ -351,6 +385,7 @@ RunOutcome Run::finish(const Integrator& integ) {
   out_.residual_imbalance_x_kgm = std::fabs(ix);
   out_.settled = out_.ok() && all_stuck(rs_, y_.data());
   out_.settling_time_s = out_.settled ? all_stuck_since_ / w_ : 0.0;
+  if (rs_.contact) out_.min_contact_clearance_rad = min_contact_clearance(p_, out_.beta_final);
   return out_;
 }
 

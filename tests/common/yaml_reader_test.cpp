@@ -52,3 +52,8 @@ TEST(YamlReader, WrongTypeAndMissingAndChoice) {
   EXPECT_EQ(error_of([] { YamlReader::load_file("/nonexistent/x.yaml"); }),
             "config file '/nonexistent/x.yaml' cannot be opened (missing or unreadable)");
 }
+
+TEST(YamlReader, NonScalarKeyIsAnUnknownKeyNotAnInternalError) {
+  auto r = YamlReader::load_string("? [a, b]\n: 1\n");
+  EXPECT_EQ(error_of([&] { r.finish(); }), "[a, b] = 1: unknown key (misspelt, or not valid here)");
+}

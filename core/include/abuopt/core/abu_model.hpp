@@ -69,11 +69,23 @@ struct ModelForces {
   // the angle sin/cos were computed for: a stuck ball's angle does not change, so its sin/cos
   // are reused (sincos was ~40 % of a run's time before).
   std::vector<double> s, c, hb, hl, r, sc_beta;
+  // evaluate_clusters() only (generalised forces, units of M omega_n^2 L^2): contact[i] is the
+  // compressive force between ball i and the next ball of its slipping cluster (0 for the last);
+  // for a stuck cluster margin_fwd[i] is the friction margin of the balls from i to the front
+  // slipping forward together, margin_bwd[i] that of the balls from the rear to i slipping backward.
+  std::vector<double> contact, margin_fwd, margin_bwd;
   explicit ModelForces(std::size_t n = 0) { resize(n); }
   void resize(std::size_t n) {
-    for (auto* v : {&betadd, &fn, &fw, &s, &c, &hb, &hl, &r}) v->assign(n, 0.0);
+    for (auto* v : {&betadd, &fn, &fw, &s, &c, &hb, &hl, &r, &contact, &margin_fwd, &margin_bwd}) v->assign(n, 0.0);
     sc_beta.assign(n, std::numeric_limits<double>::quiet_NaN());
   }
+};
+
+// Balls that move as rigid clusters (hard contact, docs/model.md section 11): groups[g] lists the
+// balls of cluster g from the rear to the front (by angle); every ball is in exactly one group and
+// the balls of a group share one mode. Singletons give the same equations as evaluate().
+struct Clusters {
+  std::vector<std::vector<std::size_t>> groups;
 };
 
 class AbuModel {
@@ -87,6 +99,12 @@ class AbuModel {
   // Solves for accelerations with the given modes (a stuck ball gets beta'' = 0 and the friction it
   // needs; a slipping ball gets mu sigma fn). `mu` may differ from nd().mu (uncertain friction).
   void evaluate(const double* y, double W, double Wp, const BallMode* modes, double mu, ModelForces& out) const;
+
+  // evaluate() for clusters: a slipping cluster has one acceleration and the friction mu sigma fn_i
+  // on each ball; a stuck one has beta'' = 0 and the friction each ball needs with no contact
+  // force (fw), plus the margins of every block that could break away (margin_fwd/bwd).
+  void evaluate_clusters(const double* y, double W, double Wp, const BallMode* modes, const Clusters& cl, double mu,
+                         ModelForces& out) const;
 
   // Friction margin of a stuck ball: mu fn - |fw| (>= 0: stick is consistent).
   static double stick_margin(const ModelForces& f, std::size_t i, double mu) {

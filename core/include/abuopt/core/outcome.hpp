@@ -24,7 +24,9 @@ struct RunOutcome {
   double settling_time_s = 0;            // from this instant all balls stick for good (if settled)
   double max_amplitude_mm = 0;           // peak of sqrt(x^2 + y^2) over the run
   double end_time_s = 0;
-  long events = 0;                       // stick/slip transitions
+  long events = 0;                       // events (stick/slip transitions, impacts, contacts)
+  long impacts = 0;                      // ball-ball impacts (hard contact)
+  double min_contact_clearance_rad = 0;  // hard contact: smallest gap - spacing at the end (>= 0)
   long rhs_evaluations = 0;
   long steps = 0;
   double wall_time_s = 0;

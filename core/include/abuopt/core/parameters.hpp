@@ -2,6 +2,7 @@
 // Physical parameters of an ABU (SI units), defaults from the 2003 report's table 3.2 with the
 // design friction mu = 0.02 (report section 4.2). Any number of balls, each its own mass/diameter.
 #include <cmath>
+#include <string>
 #include <vector>
 
 namespace abuopt {
@@ -10,6 +11,12 @@ struct Ball {
   double mass_kg = 1.4e-4;
   double diameter_m = 3.0e-3;
 };
+
+// Ball-ball contact along the rim (docs/model.md section 11). None: the report's model, the balls
+// pass through each other. Hard: neighbouring balls keep their centres at least
+// 2 asin((d_i + d_j) / 4L) apart; impacts with restitution, touching balls move as clusters.
+enum class BallContact { None, Hard };
+std::string to_string(BallContact c);
 
 struct AbuParameters {
   double table_mass_kg = 3.24e-1;        // M_T: table + motor + disc + CD (no imbalance, no balls)
@@ -22,6 +29,11 @@ struct AbuParameters {
   // Optional viscous damping of each ball relative to the rim, as a torque per angular speed
   // [N m s/rad] about the disc centre. Zero for dry ABUs; fluid-filled ABUs have some.
   double ball_damping_Nms = 0.0;
+  BallContact ball_contact = BallContact::None;
+  // Newton's coefficient of restitution of a ball-ball impact (hard contact). 0.8: hardened
+  // steel balls at impact speeds below ~1 m/s rebound with 0.8-0.95 (Goldsmith, Impact, 1960);
+  // the lower end because the balls roll in a track and the rim contact dissipates too.
+  double ball_restitution = 0.8;
   std::vector<Ball> balls = {Ball{}, Ball{}};
 
   double total_mass_kg() const {

@@ -14,7 +14,8 @@ namespace abuopt {
 
 extern const EnumNames<MotorKind> kMotorKindNames;             // ideal, pi
 extern const EnumNames<FrictionMethod> kFrictionMethodNames;   // event_driven, switch_model
-extern const EnumNames<IntegratorBackend> kIntegratorNames;    // native, arkode_erk
+extern const EnumNames<IntegratorBackend> kIntegratorNames;
+extern const EnumNames<BallContact> kBallContactNames;        // none, hard    // native, arkode_erk
 
 // The field lists. `abu` also accepts the shorthand ball_count/ball_mass_kg/ball_diameter_m for
 // identical balls (read only; written as a balls list). Reading a profile requires its segments.

@@ -1,0 +1,178 @@
+// Hard ball-ball contact (docs/model.md section 11) against closed forms.
+#include "abuopt/core/ball_contact.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <random>
+
+#include "abuopt/common/config_error.hpp"
+#include "abuopt/core/abu_model.hpp"
+#include "abuopt/core/simulator.hpp"
+
+using namespace abuopt;
+
+namespace {
+
+AbuParameters three_balls() {
+  AbuParameters p;
+  p.balls = {Ball{1.4e-4, 3.0e-3}, Ball{2.0e-4, 3.5e-3}, Ball{1.0e-4, 2.5e-3}};
+  p.ball_contact = BallContact::Hard;
+  return p;
+}
+
+Eigen::MatrixXd mass(const NondimParameters& nd, const std::vector<double>& beta) {
+  const std::size_t m = 2 + beta.size();
+  const std::vector<double> M = mass_matrix(nd, beta.data());
+  Eigen::MatrixXd E(m, m);
+  for (std::size_t a = 0; a < m; ++a)
+    for (std::size_t b = 0; b < m; ++b) E(a, b) = M[a * m + b];
+  return E;
+}
+
+}  // namespace
+
+TEST(BallContact, SpacingIsTwoArcsinesOfTheDiameters) {
+  const AbuParameters p;  // report: 3 mm balls on L = 11.5 mm: 0.262 rad
+  EXPECT_NEAR(contact_spacing(p, 0, 1), 2 * std::asin(3e-3 / (2 * 1.15e-2)), 1e-15);
+  EXPECT_NEAR(contact_spacing(p, 0, 1), 0.2617, 1e-4);
+}
+
+TEST(BallContact, FreeFlightImpactConservesMomentumAndLosesOneMinusESquaredOfTheRelativeEnergy) {
+  // Impact of balls 0 and 1 (three balls, all free, table free): the impulse acts along the gap
+  // gradient G = e_1 - e_0 only, so the generalised momenta p = M qdot of the table (x, y), of the
+  // third ball and p_0 + p_1 are conserved; the kinetic energy drops by (1 - e^2) m_eff v_rel^2 / 2
+  // with m_eff = 1 / (G M^-1 G^T), and the relative speed reverses times e.
+  const AbuParameters p = three_balls();
+  const NondimParameters nd = NondimParameters::from(p);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (double e : {0.0, 0.5, 0.8, 1.0}) {
+    for (int trial = 0; trial < 20; ++trial) {
+      const std::vector<double> beta = {0.3 + u(rng), 0.3 + u(rng) + 0.5, 4.0 + u(rng)};
+      std::vector<double> q = {0.01 * u(rng), 0.01 * u(rng), 0.5, -0.5 + 0.1 * u(rng), u(rng)};  // 0 runs into 1
+      const Eigen::MatrixXd M = mass(nd, beta);
+      Eigen::VectorXd G = Eigen::VectorXd::Zero(5);
+      G(3) = 1;
+      G(2) = -1;
+      const double m_eff = 1.0 / G.dot(M.ldlt().solve(G));
+      const double vrel = q[3] - q[2];
+      const Eigen::VectorXd p0 = M * Eigen::Map<Eigen::VectorXd>(q.data(), 5);
+      const double T0 = kinetic_energy(nd, beta.data(), q);
+      const double P = apply_impact(nd, beta.data(), q, {0, 1, 2}, {0, 0, 0}, 0, 1, e);
+      const Eigen::VectorXd p1 = M * Eigen::Map<Eigen::VectorXd>(q.data(), 5);
+      const double T1 = kinetic_energy(nd, beta.data(), q);
+      EXPECT_NEAR(P, (1 + e) * m_eff * -vrel, 1e-14);
+      EXPECT_NEAR(p1(0), p0(0), 1e-15);
+      EXPECT_NEAR(p1(1), p0(1), 1e-15);
+      EXPECT_NEAR(p1(4), p0(4), 1e-15);
+      EXPECT_NEAR(p1(2) + p1(3), p0(2) + p0(3), 1e-15);
+      EXPECT_NEAR(q[3] - q[2], -e * vrel, 1e-12);
+      EXPECT_NEAR(T0 - T1, (1 - e * e) * 0.5 * m_eff * vrel * vrel, 1e-12 * T0);
+    }
+  }
+}
+
+TEST(BallContact, AStuckBystanderIsHeldAndAClusterIsHitAsOneBody) {
+  const AbuParameters p = three_balls();
+  const NondimParameters nd = NondimParameters::from(p);
+  const std::vector<double> beta = {1.0, 1.0 + contact_spacing(p, 0, 1), 1.0 + contact_spacing(p, 0, 1) + 0.5};
+  std::vector<double> q = {0, 0, 0.4, 0.0, 0.0};
+  // balls 1 and 2 are one cluster (stuck, but struck: not held); none held
+  apply_impact(nd, beta.data(), q, {0, 1, 1}, {0, 1, 1}, 0, 1, 0.0);
+  EXPECT_DOUBLE_EQ(q[3], q[4]);          // the cluster moves as one
+  EXPECT_NEAR(q[2], q[3], 1e-15);        // plastic: no relative speed left
+  std::vector<double> r = {0, 0, 0.4, 0.0, 0.0};
+  apply_impact(nd, beta.data(), r, {0, 1, 2}, {0, 0, 1}, 0, 1, 0.5);
+  EXPECT_EQ(r[4], 0.0);  // a stuck bystander keeps its (zero) speed
+}
+
+TEST(BallContact, ClusterOnARotorAtConstantSpeedIsOneBallOfTheSummedMass) {
+  // No table motion (a table so heavy that xbar'' ~ 1e-12): a slipping cluster of two touching
+  // equal balls accelerates like one ball of twice the mass, and with x = y = 0, W' = 0 both obey
+  // beta'' = mu sigma h_l / D with h_l = -(beta' + W)^2 + 2 Jbar beta' (dbar W - 2 beta').
+  AbuParameters two;
+  two.table_mass_kg = 1e6;
+  two.ball_contact = BallContact::Hard;
+  AbuParameters one = two;
+  one.balls = {Ball{2 * two.balls[0].mass_kg, two.balls[0].diameter_m}};
+  const NondimParameters nd2 = NondimParameters::from(two), nd1 = NondimParameters::from(one);
+  const AbuModel m2(nd2), m1(nd1);
+  const double W = 1.3, v = -0.2, mu = 0.02;
+  const double d = contact_spacing(two, 0, 1);
+  std::vector<double> y2 = {0, 0, 0, 0, 2.0, 2.0 + d, v, v}, y1 = {0, 0, 0, 0, 2.0, v};
+  const BallMode slip[2] = {BallMode::SlipBackward, BallMode::SlipBackward};
+  ModelForces f2(2), f1(1);
+  Clusters cl;
+  cl.groups = {{0, 1}};
+  m2.evaluate_clusters(y2.data(), W, 0.0, slip, cl, mu, f2);
+  m1.evaluate(y1.data(), W, 0.0, slip, mu, f1);
+  const double J = NondimParameters::Jbar, dbar = nd2.dbar[0];
+  const double hl = -(v + W) * (v + W) + 2 * J * v * (dbar * W - 2 * v);
+  const double closed = mu * -1.0 * hl / nd2.D[0];
+  // (the 1e6 kg table still couples at mbar ~ 3e-10: ~1e-8 relative)
+  EXPECT_NEAR(f2.betadd[0], closed, 1e-7 * std::fabs(closed));
+  EXPECT_EQ(f2.betadd[0], f2.betadd[1]);
+  EXPECT_NEAR(f1.betadd[0], closed, 1e-7 * std::fabs(closed));
+  EXPECT_NEAR(f2.betadd[0], f1.betadd[0], 1e-9 * std::fabs(closed));
+  // the rim friction of the cluster is that of the one ball: sum m_i fw_i = (m_1 + m_2) fw
+  EXPECT_NEAR(nd2.mbar[0] * f2.fw[0] + nd2.mbar[1] * f2.fw[1], nd1.mbar[0] * f1.fw[0], 1e-9 * std::fabs(nd1.mbar[0] * f1.fw[0]));
+  // equal balls with equal forces push each other with nothing: the contact force is ~0
+  EXPECT_NEAR(f2.contact[0], 0.0, 1e-12);
+}
+
+TEST(BallContact, MapOntoTheFeasibleSetKeepsBallZeroAndLeavesNoOverlap) {
+  const AbuParameters p = three_balls();
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0, 2 * M_PI);
+  for (int k = 0; k < 1000; ++k) {
+    const std::vector<double> b = {u(rng), u(rng), u(rng)};
+    const std::vector<double> m = map_onto_contact_feasible_set(p, b);
+    EXPECT_GE(min_contact_clearance(p, m), -1e-12);
+    EXPECT_DOUBLE_EQ(m[0], b[0]);
+    EXPECT_EQ(m, map_onto_contact_feasible_set(p, b));  // deterministic: replayable
+  }
+  // the same angle for all: spaced at exactly the least spacings
+  const std::vector<double> m = map_onto_contact_feasible_set(p, {1.0, 1.0, 1.0});
+  EXPECT_NEAR(min_contact_clearance(p, m), 0.0, 1e-12);
+}
+
+TEST(BallContact, BallsThatDoNotFitOrTheSwitchModelAreConfigErrors) {
+  AbuParameters p;
+  p.ball_contact = BallContact::Hard;
+  p.balls.assign(30, Ball{});  // 30 x 0.262 rad > 2 pi
+  EXPECT_THROW(validate(p), ConfigError);
+  SimulationSetup s;
+  s.abu.ball_contact = BallContact::Hard;
+  s.options.method = FrictionMethod::SwitchModel;
+  EXPECT_THROW(Simulator{s}, ConfigError);
+}
+
+namespace {
+// Final states of n random starts of the report's final profile with hard contact: every run
+// ends ok, no final state overlaps (clearance >= -1e-12 rad: rounding).
+void no_final_overlap(std::uint64_t seed, int n, int balls) {
+  SimulationSetup s;
+  s.abu.ball_contact = BallContact::Hard;
+  s.abu.balls.assign(static_cast<std::size_t>(balls), Ball{});
+  Simulator sim(s);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 2 * M_PI);
+  int failed = 0, overlaps = 0;
+  for (int k = 0; k < n; ++k) {
+    std::vector<double> b(static_cast<std::size_t>(balls));
+    for (double& x : b) x = u(rng);
+    const RunOutcome o = sim.run(b);
+    failed += !o.ok();
+    overlaps += min_contact_clearance(s.abu, o.beta_final) < -1e-12;
+    EXPECT_GE(o.min_contact_clearance_rad, -1e-12);
+  }
+  EXPECT_EQ(failed, 0) << "seed " << seed;
+  EXPECT_EQ(overlaps, 0) << "seed " << seed;
+}
+}  // namespace
+
+TEST(BallContact, NoFinalStateOverlapsTwoBalls) { no_final_overlap(101, 96, 2); }
+TEST(BallContact, NoFinalStateOverlapsFourBalls) { no_final_overlap(202, 48, 4); }
+
