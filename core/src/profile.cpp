@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
 #include "abuopt/common/config_error.hpp"
@@ -65,6 +66,24 @@ ProfileSample StartupProfile::sample(double t) const {
   s.rate_hz_per_s = 2.0 * H / dt * sh * sh;  // H/dt (1 - cos phi), without cancellation
   s.accel_hz_per_s2 = kTwoPi * H / (dt * dt) * 2.0 * sh * ch;
   return s;
+}
+
+double StartupProfile::crossing_time_s(std::size_t k, double level) const {
+  if (k >= segments_.size()) throw std::invalid_argument("StartupProfile::crossing_time_s: no segment " + std::to_string(k));
+  const double f0 = k == 0 ? start_hz_ : segments_[k - 1].end_frequency_hz;
+  const double H = segments_[k].end_frequency_hz - f0;
+  const double u = (level - f0) / H;  // in (0, 1) for a level strictly inside the segment
+  if (!(u > 0 && u < 1))
+    throw std::invalid_argument("StartupProfile::crossing_time_s: level " + std::to_string(level) +
+                                " Hz is not strictly inside segment " + std::to_string(k));
+  // (phi - sin phi)/(2 pi) rises strictly from 0 to 1 on [0, 2 pi]: bisection on phi.
+  double lo = 0, hi = kTwoPi;
+  for (int it = 0; it < 200 && hi - lo > 0; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    if (mid <= lo || mid >= hi) break;
+    if (phi_minus_sin(mid, std::sin(mid)) / kTwoPi < u) lo = mid; else hi = mid;
+  }
+  return breaks_[k] + segments_[k].duration_s * (0.5 * (lo + hi)) / kTwoPi;
 }
 
 void validate(const StartupProfile& p, const char* path_c) {

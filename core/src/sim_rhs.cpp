@@ -20,8 +20,7 @@ Speed evaluate_forces(RunState& rs, double tbar, const double* y) {
   // PI motor: states delta = theta_ref - theta [rad] and W (StateLayout::motor_delta/motor_speed).
   const double W = y[rs.lay().motor_speed()];
   const double delta = y[rs.lay().motor_delta()];
-  const double t = tbar / rs.omega_n;
-  const double f_ref = rs.motor.realised_reference_hz(rs.profile->frequency_hz(t));
+  const double f_ref = reference_hz(rs, tbar);
   const double Omega = W * rs.omega_n;
   const double Omega_ref = kTwoPi * f_ref;
   const double wm = rs.motor.omega_m_rad_s;
@@ -86,8 +85,7 @@ void rhs_plain(double tbar, const double* y, double* yd, void* user) {
     yd[lay.beta_dot(i)] = rs.forces.betadd[i];
   }
   if (rs.pi_motor) {
-    const double t = tbar / rs.omega_n;
-    const double W_ref = kTwoPi * rs.motor.realised_reference_hz(rs.profile->frequency_hz(t)) / rs.omega_n;
+    const double W_ref = kTwoPi * reference_hz(rs, tbar) / rs.omega_n;
     yd[lay.motor_delta()] = (W_ref - y[lay.motor_speed()]);  // d delta / dtbar = (Omega_ref - Omega)/omega_n
     yd[lay.motor_speed()] = sp.Wp;
   }

@@ -55,6 +55,11 @@ struct RunState {
   // The full evaluation is still used for the root functions (they need fn, fw).
   bool frozen = false;
   double frozen_sc = 0, frozen_ss = 0;
+  // PI motor with a quantised setpoint: the reference is piecewise constant and is held at the
+  // value of the current interval between its step times, which are stop times of the
+  // integration (simulator.cpp), so no step straddles a jump of the right-hand side.
+  bool ref_held = false;
+  double ref_hold_hz = 0;
   bool contact = false;  // hard ball-ball contact (two or more balls)
   ContactState cs;
 
@@ -90,6 +95,12 @@ struct Speed {
 inline Speed ideal_speed(const RunState& rs, double tbar) {
   const ProfileSample s = rs.profile->sample(tbar / rs.omega_n);
   return {kTwoPi * s.frequency_hz / rs.omega_n, kTwoPi * s.rate_hz_per_s / (rs.omega_n * rs.omega_n)};
+}
+
+// The reference frequency [Hz] the PI motor follows at tbar.
+inline double reference_hz(const RunState& rs, double tbar) {
+  if (rs.ref_held) return rs.ref_hold_hz;
+  return rs.motor.realised_reference_hz(rs.profile->frequency_hz(tbar / rs.omega_n));
 }
 
 // Evaluates forces for the current modes into rs.forces and returns the speed used (sim_rhs.cpp).

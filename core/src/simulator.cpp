@@ -98,6 +98,13 @@ class Run {
     out_.end_time_s = end_time_s;
     L_mm_ = p_.ball_track_radius_m * 1e3;
     traj_dt_ = rs_.opt.trajectory_interval_s * w_;
+    if (rs_.pi_motor && rs_.motor.quantize_setpoint_1hz) {
+      // The quantised reference is piecewise constant: its step times join the profile's
+      // breakpoints as stop times, and it is held per interval (docs/model.md).
+      rs_.ref_held = true;
+      for (double s : rs_.motor.reference_step_times_s(setup_.profile)) ref_steps_.push_back(s * w_);
+      hold_reference_after(0.0);
+    }
 
     y_.assign(nvar_, 0.0);
     // Angles relative to the imbalance; an imbalance at angle phi sees the balls at beta - phi.
@@ -133,6 +140,10 @@ class Run {
       all_stuck_since_ = -1;
     }
   }
+  // Quantised reference: hold the value of the interval that starts at tbar (the value at the
+  // interval's middle, away from the jumps), and re-choose the modes at a jump.
+  void hold_reference_after(double tbar);
+  void reference_step(double t);
   void record(double tt, const std::vector<double>& yy);
   RunOutcome finish(const Integrator& integ);
 
@@ -151,7 +162,39 @@ class Run {
   std::vector<int> rinfo_;
   std::vector<char> fixed_;
   std::deque<double> recent_events_;
+  std::vector<double> ref_steps_;  // step times of the quantised reference (tbar), sorted
 };
+
+void Run::hold_reference_after(double tbar) {
+  // next stop after tbar: a reference step or a profile breakpoint (or the profile's end)
+  double next = std::max(t_end_, t_profile_) + 1.0;
+  for (double b : setup_.profile.breakpoints_s())
+    if (b * w_ > tbar) next = std::min(next, b * w_);
+  const auto it = std::upper_bound(ref_steps_.begin(), ref_steps_.end(), tbar);
+  if (it != ref_steps_.end()) next = std::min(next, *it);
+  const double mid = 0.5 * (tbar + next) / w_;
+  rs_.ref_hold_hz = rs_.motor.realised_reference_hz(setup_.profile.frequency_hz(mid));
+}
+
+// At a stop time with the quantised reference: the motor's W' (and with it every stuck ball's
+// friction margin) may jump. Re-choose the modes with the new reference, as at a root; the caller
+// resets the integrator and the root offsets.
+void Run::reference_step(double t) {
+  const double old_ref = rs_.ref_hold_hz;
+  hold_reference_after(t);
+  if (rs_.ref_hold_hz == old_ref || !event_driven_) return;  // the switch model re-chooses per call
+  const std::vector<BallMode> before = rs_.modes;
+  for (std::size_t i = 0; i < rs_.n; ++i)
+    if (rs_.modes[i] == BallMode::Stick) y_[lay_.beta_dot(i)] = 0.0;
+  const Speed sp = evaluate_forces(rs_, t, y_.data());
+  if (rs_.contact)
+    choose_contact_modes(rs_, sp.W, sp.Wp, y_, std::vector<char>(rs_.n, 0));
+  else
+    rs_.model.choose_modes(y_.data(), sp.W, sp.Wp, rs_.mu, 0.0, rs_.modes.data(), rs_.forces);
+  rs_.modes_changed(y_.data());
+  if (rs_.modes != before) ++out_.events;
+  track_all_stuck(t);
+}
 
 // Initial modes from what happens just after t = 0: at rest every force is zero, so decide at a
 // tiny time with the rest state (forces then scale alike and the relative test works).
@@ -162,7 +205,7 @@ void Run::choose_initial_modes() {
   std::vector<double> yprobe(y_);
   if (rs_.pi_motor) {
     // the reference has moved a little; the disc has not
-    const double fr = rs_.motor.realised_reference_hz(setup_.profile.frequency_hz(tiny / w));
+    const double fr = reference_hz(rs_, tiny);
     yprobe[lay_.motor_delta()] = 0.25 * kTwoPi * fr / w * tiny;  // delta ~ integral of the reference speed
   }
   Speed sp = rs_.pi_motor ? Speed{0, 0} : ideal_speed(rs_, tiny);
@@ -255,6 +298,12 @@ RunOutcome Run::execute() {
   std::vector<double> breaks;
   for (double b : setup_.profile.breakpoints_s())
     if (b * w_ > 0 && b * w_ < t_end_) breaks.push_back(b * w_);
+  if (!ref_steps_.empty()) {
+    for (double b : ref_steps_)
+      if (b > 0 && b < t_end_) breaks.push_back(b);
+    std::sort(breaks.begin(), breaks.end());
+    breaks.erase(std::unique(breaks.begin(), breaks.end()), breaks.end());
+  }
   breaks.push_back(t_end_);
   std::size_t next_break = 0;
   integ.set_stop(breaks[0]);
@@ -301,6 +350,10 @@ RunOutcome Run::execute() {
     if (next_break < breaks.size() && t >= breaks[next_break]) {
       ++next_break;
       if (next_break < breaks.size()) integ.set_stop(breaks[next_break]);
+      if (rs_.ref_held && t < t_end_) {
+        reference_step(t);
+        reset_needed = true;
+      }
     }
     if (t >= t_end_) break;
 

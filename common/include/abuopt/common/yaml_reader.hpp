@@ -7,7 +7,7 @@
 //   "simulation.rtol = abc: must be a number"
 //
 //   YamlReader root = YamlReader::load_file("configs/x.yaml");
-//   double mu = root.get_or<double>("mu", 0.02, Rule::non_negative());
+//   double mu = root.get_double_or("mu", 0.02, Rule::non_negative());
 //   YamlReader sim = root.child("simulation");     // optional section: empty reader if absent
 //   ...; sim.finish(); root.finish();
 #include <functional>

@@ -8,6 +8,9 @@
 //   with the setpoint mismatch of the drive f_real = f_target - (f_target + 1)/64 (eq 2.1) and
 //   1 Hz setpoint quantisation as options.
 #include <string>
+#include <vector>
+
+#include "abuopt/core/profile.hpp"
 
 namespace abuopt {
 
@@ -25,6 +28,12 @@ struct MotorModel {
   bool quantize_setpoint_1hz = false;  // round the reference frequency to whole Hz
   // Reference frequency the drive actually follows for a target frequency (mismatch/quantisation).
   double realised_reference_hz(double target_hz) const;
+  // With quantize_setpoint_1hz the realised reference is piecewise constant: it jumps where the
+  // profile frequency crosses k + 1/2 Hz inside a segment (and possibly at segment breakpoints).
+  // Returns those inside-segment crossing times [s], sorted (empty without quantisation). The
+  // simulator integrates piecewise between them and the breakpoints (docs/model.md, "Quantised
+  // reference").
+  std::vector<double> reference_step_times_s(const StartupProfile& profile) const;
 };
 
 std::string to_string(MotorKind k);

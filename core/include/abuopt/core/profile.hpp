@@ -39,6 +39,10 @@ class StartupProfile {
   const std::vector<InclinedSineSegment>& segments() const { return segments_; }
   // Start times of each segment, plus the end time (size segments()+1).
   const std::vector<double>& breakpoints_s() const { return breaks_; }
+  // The time in segment k where f(t) = level, for a level strictly between the segment's end
+  // frequencies (f is strictly monotone inside a rising or falling segment): phi - sin phi =
+  // 2 pi (level - f0)/H solved by bisection to rounding. std::invalid_argument otherwise.
+  double crossing_time_s(std::size_t k, double level_hz) const;
 
  private:
   std::vector<InclinedSineSegment> segments_;
