@@ -1,4 +1,5 @@
 // abuopt: design optimisation of startup profiles for Automatic Balancing Units.
+#include <csignal>
 #include <exception>
 #include <filesystem>
 #include <new>
@@ -17,6 +18,9 @@ int exit_code() { return g_exit_code; }
 }  // namespace abuopt::app
 
 int main(int argc, char** argv) {
+  // A file-size limit (ulimit -f) must fail a write like a full disk does (exit 4, nothing
+  // half-written under the final name), not kill the process with SIGXFSZ.
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{
       "abuopt: simulate an Automatic Balancing Unit (ABU) during startup, evaluate startup profiles\n"
       "by Monte Carlo over initial ball positions, and optimise them.\n"

@@ -127,6 +127,14 @@ fs::path make_out_dir(const std::string& dir, const std::string& option) {
 int run_single(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig& cfg, double freq, std::size_t n) {
   const EquilibriumGrid g = set.grid(freq, n, cfg.other_angles_rad);
   const std::size_t nb = g.n_balls;
+  // An amplitude that is not finite is no result (an undamped table exactly at resonance): say so
+  // instead of printing NaN or inf, before any file is written.
+  for (double amp : g.amplitude_mm)
+    if (!std::isfinite(amp)) {
+      std::cerr << "abuopt: error: the steady amplitude is not finite at " << num_text(freq)
+                << " Hz (an undamped table at its resonance, abu.damping_Ns_per_m = 0?): no equilibrium set to draw\n";
+      return 3;
+    }
   const fs::path dir = make_out_dir(a.out.empty() ? "results/eqset-" + num_text(freq) + "Hz" : a.out, "--out");
   const fs::path csv = dir / "equilibrium_set.csv";
   {

@@ -188,7 +188,12 @@ int run_montecarlo(const MonteCarloArgs& a) {
               << std::setprecision(6) << format_summary(stats);
     if (!a.out.empty()) std::cout << "wrote " << a.out << "/runs.csv and " << a.out << "/summary.json\n";
   }
-  return stats.ok == 0 ? 3 : 0;
+  if (stats.ok == 0) {
+    std::cerr << "abuopt: every run failed (" << stats.failed << " of " << s.runs
+              << "; the status counts above say why), so there is no statistic to report\n";
+    return 3;
+  }
+  return 0;
 }
 
 }  // namespace

@@ -218,7 +218,12 @@ int run_optimize(const OptimizeArgs& a) {
       os << std::setprecision(6) << r.objective;
     else
       os << "FAILED (" << r.message << ")";
-    os << "  viol=" << std::setprecision(3) << r.max_violation << "  best=";
+    os << "  viol=";
+    if (r.ok)
+      os << std::setprecision(3) << r.max_violation;
+    else
+      os << "-";
+    os << "  best=";
     if (p.have_feasible)
       os << std::setprecision(6) << p.best_objective;
     else
@@ -340,7 +345,12 @@ int run_optimize(const OptimizeArgs& a) {
               << " (the files above hold the evaluations up to it)\n";
     return 3;
   }
-  return r.has_feasible_point() ? 0 : 3;
+  if (!r.has_feasible_point()) {
+    std::cerr << "abuopt: no feasible design found in " << r.evaluations
+              << " evaluations (every design violates a constraint or failed; see the table above)\n";
+    return 3;
+  }
+  return 0;
 }
 
 }  // namespace

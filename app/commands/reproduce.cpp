@@ -120,7 +120,11 @@ int run_reproduce(const ReproduceArgs& a) {
   bool all_failed_somewhere = false;
   for (const TableResult& t : r.tables)
     for (const CaseSummary& s : t.rows) all_failed_somewhere = all_failed_somewhere || s.ok == 0;
-  return all_failed_somewhere ? 3 : 0;
+  if (all_failed_somewhere) {
+    std::cerr << "abuopt: every run of at least one case failed (see the failed column of its table)\n";
+    return 3;
+  }
+  return 0;
 }
 
 }  // namespace

@@ -133,7 +133,12 @@ int run_simulate(const SimulateArgs& a) {
               << o.rhs_evaluations << " RHS evaluations, " << o.wall_time_s * 1e3 << " ms\n";
     if (!a.trajectory.empty()) std::cout << "trajectory:           " << a.trajectory << " (" << traj.size() << " points)\n";
   }
-  return o.ok() ? 0 : 3;
+  if (!o.ok()) {
+    std::cerr << "abuopt: the simulation failed: " << to_string(o.status)
+              << (o.message.empty() ? std::string() : ": " + o.message) << "\n";
+    return 3;
+  }
+  return 0;
 }
 
 }  // namespace

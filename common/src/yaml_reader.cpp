@@ -33,6 +33,18 @@ Rule Rule::in_range(double lo, double hi) {
                : "must be in [" + fmt(lo) + ", " + fmt(hi) + "]";
   }};
 }
+Rule Rule::positive_at_most(double hi) {
+  return {[hi](double v) {
+    if (!(std::isfinite(v) && v > 0)) return std::string("must be > 0");
+    return v <= hi ? std::string() : "must be <= " + fmt(hi) + " (the largest value abuopt accepts here)";
+  }};
+}
+Rule Rule::non_negative_at_most(double hi) {
+  return {[hi](double v) {
+    if (!(std::isfinite(v) && v >= 0)) return std::string("must be >= 0");
+    return v <= hi ? std::string() : "must be <= " + fmt(hi) + " (the largest value abuopt accepts here)";
+  }};
+}
 Rule Rule::at_least(double lo) {
   return {[lo](double v) { return (std::isfinite(v) && v >= lo) ? std::string() : "must be >= " + fmt(lo); }};
 }

@@ -23,8 +23,8 @@ void read_ball_shorthand(YamlReader& r, AbuParameters& p) {
                       "give either a balls list or ball_count/ball_mass_kg/ball_diameter_m, not both");
   const long count = r.get_int_or("ball_count", 2, Rule::in_range(0, 64));
   Ball ball;
-  ball.mass_kg = r.get_double_or("ball_mass_kg", ball.mass_kg, Rule::positive());
-  ball.diameter_m = r.get_double_or("ball_diameter_m", ball.diameter_m, Rule::positive());
+  ball.mass_kg = r.get_double_or("ball_mass_kg", ball.mass_kg, Rule::positive_at_most(AbuLimits::kMassKg));
+  ball.diameter_m = r.get_double_or("ball_diameter_m", ball.diameter_m, Rule::positive_at_most(AbuLimits::kLengthM));
   if (has_count) p.balls.assign(static_cast<std::size_t>(count), ball);
 }
 
@@ -64,20 +64,20 @@ Rule end_time_rule() {
 }  // namespace
 
 void describe_fields(FieldArchive& a, Ball& b) {
-  a.field("mass_kg", b.mass_kg, Rule::positive());
-  a.field("diameter_m", b.diameter_m, Rule::positive());
+  a.field("mass_kg", b.mass_kg, Rule::positive_at_most(AbuLimits::kMassKg));
+  a.field("diameter_m", b.diameter_m, Rule::positive_at_most(AbuLimits::kLengthM));
 }
 
 void describe_fields(FieldArchive& a, AbuParameters& p) {
   if (YamlReader* r = a.reader()) read_ball_shorthand(*r, p);
-  a.field("table_mass_kg", p.table_mass_kg, Rule::positive());
-  a.field("damping_Ns_per_m", p.damping_Ns_per_m, Rule::non_negative());
-  a.field("stiffness_N_per_m", p.stiffness_N_per_m, Rule::positive());
-  a.field("ball_track_radius_m", p.ball_track_radius_m, Rule::positive());
-  a.field("imbalance_mass_kg", p.imbalance_mass_kg, Rule::non_negative());
-  a.field("eccentricity_m", p.eccentricity_m, Rule::non_negative());
+  a.field("table_mass_kg", p.table_mass_kg, Rule::positive_at_most(AbuLimits::kMassKg));
+  a.field("damping_Ns_per_m", p.damping_Ns_per_m, Rule::non_negative_at_most(AbuLimits::kDampingNsPerM));
+  a.field("stiffness_N_per_m", p.stiffness_N_per_m, Rule::positive_at_most(AbuLimits::kStiffnessNPerM));
+  a.field("ball_track_radius_m", p.ball_track_radius_m, Rule::positive_at_most(AbuLimits::kLengthM));
+  a.field("imbalance_mass_kg", p.imbalance_mass_kg, Rule::non_negative_at_most(AbuLimits::kMassKg));
+  a.field("eccentricity_m", p.eccentricity_m, Rule::non_negative_at_most(AbuLimits::kLengthM));
   a.field("friction_mu", p.friction_mu, Rule::in_range(0.0, 0.999));
-  a.field("ball_damping_Nms", p.ball_damping_Nms, Rule::non_negative());
+  a.field("ball_damping_Nms", p.ball_damping_Nms, Rule::non_negative_at_most(AbuLimits::kBallDampingNms));
   a.field("ball_contact", p.ball_contact, kBallContactNames);
   a.field("ball_restitution", p.ball_restitution, Rule::in_range(0.0, 1.0));
   a.items("balls", p.balls);
@@ -90,14 +90,14 @@ void describe_fields(FieldArchive& a, AbuParameters& p) {
 }
 
 void describe_fields(FieldArchive& a, InclinedSineSegment& s) {
-  a.field("end_frequency_hz", s.end_frequency_hz, Rule::non_negative(), FieldOptions::required_key());
-  a.field("duration_s", s.duration_s, Rule::positive(), FieldOptions::required_key());
+  a.field("end_frequency_hz", s.end_frequency_hz, Rule::non_negative_at_most(kMaxFrequencyHz), FieldOptions::required_key());
+  a.field("duration_s", s.duration_s, Rule::positive_at_most(kMaxSegmentDurationS), FieldOptions::required_key());
 }
 
 void describe_fields(FieldArchive& a, StartupProfile& p) {
   double f0 = p.start_frequency_hz();
   std::vector<InclinedSineSegment> segments = p.segments();
-  a.field("start_frequency_hz", f0, Rule::non_negative());
+  a.field("start_frequency_hz", f0, Rule::non_negative_at_most(kMaxFrequencyHz));
   a.items("segments", segments, FieldOptions::required_key("(a list of {end_frequency_hz, duration_s})"));
   if (a.reading() && segments.empty()) throw ConfigError(a.path("segments"), "[]", "must have at least one segment");
   // A class, not a plain struct: rebuilt when the fields changed (by reading, or any other archive).

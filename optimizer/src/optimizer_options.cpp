@@ -38,7 +38,10 @@ void OptimizerOptions::validate() const {
                         local.name + " cannot be a local algorithm of NLopt");
   }
   if (info.name == "SAO") sao.validate("sao");
+  // The history keeps every evaluation: a budget beyond 1e7 is a typo, not a study.
   require(max_evaluations > 0, "max_evaluations", static_cast<double>(max_evaluations), "must be > 0");
+  require(max_evaluations <= 10'000'000, "max_evaluations", static_cast<double>(max_evaluations),
+          "must be <= 10000000 (the history keeps every evaluation)");
   require(std::isfinite(max_time_s) && max_time_s >= 0, "max_time_s", max_time_s, "must be >= 0 (0: no limit)");
   require(max_iterations >= 0, "max_iterations", static_cast<double>(max_iterations), "must be >= 0 (0: default)");
   require(std::isfinite(xtol_rel) && xtol_rel >= 0, "xtol_rel", xtol_rel, "must be >= 0");
@@ -62,7 +65,7 @@ void describe_fields(FieldArchive& a, OptimizerOptions& o) {
   FieldOptions local;
   local.enabled = a.reading() || !o.local_algorithm.empty();  // empty: the default (never written)
   a.field("local_algorithm", o.local_algorithm, local);
-  a.field("max_evaluations", o.max_evaluations, Rule::positive());
+  a.field("max_evaluations", o.max_evaluations, Rule::positive_at_most(1e7));
   a.field("max_time_s", o.max_time_s, Rule::non_negative());
   a.field("max_iterations", o.max_iterations, Rule::non_negative());
   a.field("xtol_rel", o.xtol_rel, Rule::non_negative());

@@ -37,6 +37,10 @@ void check_value(const DesignValue& v, const std::string& path, bool duration) {
       throw ConfigError(path, format_number(v.value), "must be > 0 (a profile with a duration <= 0 is never simulated)");
     if (!duration && !(std::isfinite(v.value) && v.value >= 0))
       throw ConfigError(path, format_number(v.value), "must be >= 0 (" + kind + ")");
+    if (v.value > (duration ? kMaxSegmentDurationS : kMaxFrequencyHz))
+      throw ConfigError(path, format_number(v.value),
+                        "must be <= " + format_number(duration ? kMaxSegmentDurationS : kMaxFrequencyHz) +
+                            (duration ? " s" : " Hz") + " (the largest value a profile may have)");
     return;
   }
   if (!std::isfinite(v.lower)) throw ConfigError(path + ".min", format_number(v.lower), "must be finite");
@@ -49,6 +53,11 @@ void check_value(const DesignValue& v, const std::string& path, bool duration) {
                       "must be > 0 (a profile with a duration <= 0 is never simulated)");
   if (!duration && v.lower < 0)
     throw ConfigError(path + ".min", format_number(v.lower), "must be >= 0 (" + kind + ")");
+  const double limit = duration ? kMaxSegmentDurationS : kMaxFrequencyHz;
+  if (v.upper > limit)
+    throw ConfigError(path + ".max", format_number(v.upper),
+                      "must be <= " + format_number(limit) + (duration ? " s" : " Hz") +
+                          " (the largest " + (duration ? "segment duration" : "frequency") + " a profile may have)");
   if (!(v.value >= v.lower && v.value <= v.upper))
     throw ConfigError(path + ".x0", format_number(v.value),
                       "must be in [" + format_number(v.lower) + ", " + format_number(v.upper) + "] (the bounds)");
@@ -244,8 +253,9 @@ void validate(const StartupProfileSettings& s) {
   validate_fields(s.constraints, "constraints");
   const ProfileDesign& d = s.design;
   if (d.segments.empty()) throw ConfigError("design.segments", "[]", "must have at least one segment");
-  if (!(std::isfinite(d.start_frequency_hz) && d.start_frequency_hz >= 0))
-    throw ConfigError("design.start_frequency_hz", format_number(d.start_frequency_hz), "must be >= 0");
+  if (!(std::isfinite(d.start_frequency_hz) && d.start_frequency_hz >= 0 && d.start_frequency_hz <= kMaxFrequencyHz))
+    throw ConfigError("design.start_frequency_hz", format_number(d.start_frequency_hz),
+                      "must be in [0, " + format_number(kMaxFrequencyHz) + "] Hz");
   std::size_t free = 0;
   for (std::size_t i = 0; i < d.segments.size(); ++i) {
     if (!d.segments[i].hold) check_value(d.segments[i].end_frequency_hz, segment_path(i) + ".end_frequency_hz", false);

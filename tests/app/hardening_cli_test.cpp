@@ -127,5 +127,74 @@ TEST(HardeningCli, RefusedThreadsMeanFewerThreadsNotACrash) {
 #endif
 }
 
+// Found by tests/probe/bad_input_probe.py (seed 2026): without `trap '' XFSZ` in the caller, a
+// file-size limit killed the process with SIGXFSZ (no message, no exit status) instead of failing
+// the write like a full disk.
+TEST(HardeningCli, AFileSizeLimitIsExitFourNotASignal) {
+  const fs::path out = fresh_dir("hardening_fsize");
+  const auto r = run_abuopt("montecarlo " + kMc + " --design random --runs 1024 --out " + out.string(), "ulimit -f 128;");
+  EXPECT_EQ(r.status, 4) << r.output;
+  EXPECT_HAS(r.output, "runs.csv");
+  EXPECT_FALSE(fs::exists(out / "runs.csv"));
+  fs::remove_all(out);
+}
+
+std::string config_with(const std::string& from, const std::string& key_line, const std::string& replacement,
+                        const std::string& name) {
+  std::ifstream in(from);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto at = text.find(key_line);
+  EXPECT_NE(at, std::string::npos) << key_line;
+  text.replace(at, key_line.size(), replacement);
+  const std::string path = std::string(ABUOPT_BINARY_DIR) + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+// Found by the probe: finite but absurd physical values were accepted and gave NaN/inf amplitudes
+// (eqset printed "amplitude [mm]: -nan .. -nan" with exit 0) or ran into the step limit for hours of
+// simulated time. Each has an upper limit now, named in the message.
+TEST(HardeningCli, AbsurdPhysicalValuesNameTheirLimit) {
+  const std::string eq = kSrc + "/configs/eqset.yaml";
+  auto cfg = config_with(eq, "table_mass_kg: 0.324", "table_mass_kg: 1e308", "hardening_mass.yaml");
+  auto r = run_abuopt("eqset " + cfg + " --freq 29 --grid 12 --out " + fresh_dir("hardening_mass").string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_HAS(r.output, "abu.table_mass_kg");
+  EXPECT_HAS(r.output, "must be <= 10000");
+  EXPECT_EQ(r.output.find("nan"), std::string::npos) << r.output;
+
+  cfg = config_with(kSim, "duration_s: 8.0", "duration_s: 1e308", "hardening_duration.yaml");
+  r = run_abuopt("simulate " + cfg);
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_HAS(r.output, "duration_s");
+  EXPECT_HAS(r.output, "100000");
+
+  cfg = config_with(kSrc + "/configs/optimize/quick.yaml", "max: 28, x0: 25", "max: 4294967297, x0: 25",
+                    "hardening_design_max.yaml");
+  r = run_abuopt("optimize " + cfg + " --max-evaluations 2 --out " + fresh_dir("hardening_design_max").string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_HAS(r.output, "design.segments[0].end_frequency_hz.max");
+  EXPECT_HAS(r.output, "10000 Hz");
+
+  r = run_abuopt("optimize " + kSrc + "/configs/optimize/quick.yaml --max-evaluations 4294967297 --out " +
+                 fresh_dir("hardening_budget").string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_HAS(r.output, "max_evaluations");
+}
+
+// Found by the probe: exit 3 with nothing on stderr (the reason only inside the JSON or the table).
+TEST(HardeningCli, AFailedComputationSaysWhyOnStderr) {
+  const std::string cfg = config_with(kSim, "simulation:", "simulation:\n  max_steps: 10", "hardening_steps.yaml");
+  auto r = run_abuopt("simulate " + cfg + " --json", "", /*with_stderr=*/true);
+  EXPECT_EQ(r.status, 3) << r.output;
+  EXPECT_HAS(r.output, "abuopt: the simulation failed: step_limit");
+  r = run_abuopt("simulate " + cfg + " --json", "", /*with_stderr=*/false);
+  EXPECT_EQ(r.output.find("abuopt: the simulation failed"), std::string::npos) << "the reason belongs on stderr";
+  const std::string mc = config_with(kMc, "simulation:", "simulation:\n  max_steps: 10", "hardening_mc_steps.yaml");
+  r = run_abuopt("montecarlo " + mc + " --design random --runs 4");
+  EXPECT_EQ(r.status, 3) << r.output;
+  EXPECT_HAS(r.output, "abuopt: every run failed (4 of 4");
+}
+
 }  // namespace
 }  // namespace abuopt

@@ -30,6 +30,8 @@ struct Rule {
   static Rule non_negative();                   // >= 0
   static Rule in_range(double lo, double hi);   // lo <= v <= hi
   static Rule at_least(double lo);              // >= lo
+  static Rule positive_at_most(double hi);      // 0 < v <= hi ("must be > 0" / "must be <= hi")
+  static Rule non_negative_at_most(double hi);  // 0 <= v <= hi ("must be >= 0" / "must be <= hi")
 };
 
 class YamlReader {

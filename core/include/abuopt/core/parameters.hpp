@@ -18,6 +18,17 @@ struct Ball {
 enum class BallContact { None, Hard };
 std::string to_string(BallContact c);
 
+// Upper limits of the physical parameters a config may give (docs/config.md, "Limits"): orders of
+// magnitude beyond any balancing unit, so that no product of the model's quantities overflows a
+// double (an amplitude of 1e308 m is not a result).
+struct AbuLimits {
+  static constexpr double kMassKg = 1e4;             // table, each ball, the imbalance mass
+  static constexpr double kLengthM = 10.0;           // track radius, eccentricity, ball diameter
+  static constexpr double kStiffnessNPerM = 1e9;
+  static constexpr double kDampingNsPerM = 1e6;
+  static constexpr double kBallDampingNms = 1e3;
+};
+
 struct AbuParameters {
   double table_mass_kg = 3.24e-1;        // M_T: table + motor + disc + CD (no imbalance, no balls)
   double damping_Ns_per_m = 1.28;        // b

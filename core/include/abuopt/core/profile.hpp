@@ -12,6 +12,12 @@
 
 namespace abuopt {
 
+// The largest rotor frequency and segment duration a config may ask for: far beyond any ABU (CD
+// drives turn at up to ~200 Hz, hand tools ~1 kHz), small enough that no product of the model's
+// quantities overflows a double (docs/config.md, "Limits").
+inline constexpr double kMaxFrequencyHz = 1e4;
+inline constexpr double kMaxSegmentDurationS = 1e5;
+
 struct InclinedSineSegment {
   double end_frequency_hz = 0.0;
   double duration_s = 1.0;
