@@ -1,0 +1,48 @@
+// The command line helps a user who mistypes: "did you mean" for a subcommand, a flag and a config
+// key.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+
+#include "abuopt_cli.hpp"
+
+namespace {
+
+using abuopt::test::run_abuopt;
+
+const std::string kConfigs = std::string(ABUOPT_SOURCE_DIR) + "/configs/";
+
+TEST(UsabilityCli, MisspeltSubcommandGetsASuggestion) {
+  const auto r = run_abuopt("montecarol " + kConfigs + "montecarlo_final_profile.yaml");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("'montecarol' is not a command; did you mean 'montecarlo'?"), std::string::npos) << r.output;
+}
+
+TEST(UsabilityCli, MisspeltFlagGetsASuggestion) {
+  const auto r = run_abuopt("montecarlo " + kConfigs + "montecarlo_final_profile.yaml --seeds 3");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("'--seeds' is not an option; did you mean '--seed'?"), std::string::npos) << r.output;
+  const auto q = run_abuopt("reproduce --no-plot");
+  EXPECT_EQ(q.status, 2);
+  EXPECT_NE(q.output.find("did you mean '--no-plots'?"), std::string::npos) << q.output;
+}
+
+TEST(UsabilityCli, NothingCloseGivesNoGuess) {
+  const auto r = run_abuopt("frobnicate");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output.find("did you mean"), std::string::npos) << r.output;
+}
+
+TEST(UsabilityCli, MisspeltConfigKeyGetsASuggestion) {
+  const std::string path = std::string(ABUOPT_BINARY_DIR) + "/usability_misspelt.yaml";
+  std::ofstream(path) << "abu: {fricton_mu: 0.02}\n";
+  const auto r = run_abuopt("simulate " + path + " --beta0 0.5,3.0");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("abu.fricton_mu = 0.02: unknown key (misspelt, or not valid here); did you mean "
+                          "'friction_mu'?"),
+            std::string::npos)
+      << r.output;
+}
+
+}  // namespace
