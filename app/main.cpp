@@ -10,6 +10,7 @@
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/suggest.hpp"
+#include "abuopt/studies/terms.hpp"
 #include "commands/commands.hpp"
 
 namespace abuopt::app {
@@ -63,6 +64,7 @@ int main(int argc, char** argv) {
       "design, an evaluation error ended it, out of memory); 4 an output file could not be written (disk\n"
       "full, no permission: nothing half-written is left under its name); 130 interrupted (Ctrl-C).\n"
       "docs/security.md says what abuopt trusts, where it writes and how it runs gnuplot."};
+  app.footer("\n" + abuopt::terms_text(""));
   app.require_subcommand(1);
   app.set_version_flag("--version", "abuopt 0.1.0");
   abuopt::app::register_simulate(app);

@@ -1,5 +1,5 @@
 // The command line helps a user who mistypes: "did you mean" for a subcommand, a flag and a config
-// key.
+// key; long commands show progress on stderr only when asked (or on a terminal).
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -43,6 +43,18 @@ TEST(UsabilityCli, MisspeltConfigKeyGetsASuggestion) {
                           "'friction_mu'?"),
             std::string::npos)
       << r.output;
+}
+
+TEST(UsabilityCli, ProgressOnlyWhenAskedOffATerminal) {
+  // stderr is a pipe here: no progress line unless --progress.
+  const std::string base = "montecarlo " + kConfigs + "montecarlo_final_profile.yaml --runs 16 --design random --threads 1";
+  const auto quiet = run_abuopt(base);
+  ASSERT_EQ(quiet.status, 0) << quiet.output;
+  EXPECT_EQ(quiet.output.find("Monte Carlo: 16/16 runs"), std::string::npos) << quiet.output;
+  const auto shown = run_abuopt(base + " --progress");
+  ASSERT_EQ(shown.status, 0) << shown.output;
+  EXPECT_NE(shown.output.find("Monte Carlo: 16/16 runs (100.0 %)"), std::string::npos) << shown.output;
+  EXPECT_EQ(shown.output.find('\r'), std::string::npos);  // whole lines off a terminal
 }
 
 }  // namespace
