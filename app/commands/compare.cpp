@@ -187,7 +187,7 @@ void register_compare(CLI::App& app) {
       "compare",
       "Compare optimisers (NLopt algorithms, IPOPT, SAO) on benchmark problems from several starts, each\n"
       "with an evaluation budget: a table (solved runs, evaluations to reach tau, best value, feasibility,\n"
-      "time), convergence curves, data profiles and performance profiles (CSV, and PNG with gnuplot).\n"
+      "time), convergence curves, data profiles and performance profiles (CSV, and PNG + PDF with gnuplot).\n"
       "Exit status: 0 ok, 2 bad input.");
   sub->add_option("config", args->config, "YAML config (tau, problems, solvers; see configs/compare/)")->required();
   sub->add_option("--out", args->out, "output directory (default results/compare-<timestamp>/)");

@@ -458,10 +458,11 @@ void register_eqset(CLI::App& app) {
       "eqset",
       "Equilibrium set at constant speed (report fig 4.3): the ball angles (beta_1, beta_2) where all balls\n"
       "can stay stuck, with the steady vibration amplitude there.\n"
-      "  --freq HZ: writes DIR/equilibrium_set.csv and .png (set and amplitude contours); prints coverage\n"
+      "  --freq HZ: writes DIR/equilibrium_set.csv, .png and .pdf (set and amplitude contours); prints coverage\n"
       "  --scan FROM:TO:STEP: prints per frequency the coverage and the residual imbalance the set allows\n"
       "    (smallest/median/largest |I_r|, I_r,x over the set and around the balancing points), the band\n"
-      "    where the coverage is below 1; with --out also residual.csv/.png.\n"
+      "    where the coverage is below 1; with --out also residual.csv/.png/.pdf. '-' (an empty CSV field): that\n"
+      "    part has no grid point (the boundary columns outside the band, where the set is the plane).\n"
       "Exit status: 0 ok, 2 bad input.");
   sub->add_option("config", args->config, "YAML config (section abu; optional section eqset)")->required();
   auto* freq = sub->add_option("--freq", args->freq, "constant speed in Hz (> 0)");
