@@ -1,12 +1,17 @@
 // abuopt: design optimisation of startup profiles for Automatic Balancing Units.
+#include <algorithm>
 #include <csignal>
 #include <exception>
 #include <filesystem>
 #include <new>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/output_file.hpp"
+#include "abuopt/common/suggest.hpp"
+#include "abuopt/studies/terms.hpp"
 #include "commands/commands.hpp"
 
 namespace abuopt::app {
@@ -15,6 +20,39 @@ int g_exit_code = 0;
 }
 void set_exit_code(int code) { g_exit_code = code; }
 int exit_code() { return g_exit_code; }
+
+// After a parse error: "did you mean" for the first argument that is neither a subcommand (in
+// first place) nor an option of the chosen subcommand ("" when nothing is close).
+std::string hint_for(CLI::App& app, int argc, char** argv) {
+  if (argc < 2) return "";
+  const std::string first = argv[1];
+  if (first.empty() || first[0] == '-') return "";
+  const std::vector<CLI::App*> subs = app.get_subcommands([](CLI::App*) { return true; });
+  std::vector<std::string> names;
+  CLI::App* sub = nullptr;
+  for (CLI::App* s : subs) {
+    names.push_back(s->get_name());
+    if (s->get_name() == first) sub = s;
+  }
+  if (!sub) {
+    const auto m = closest_match(first, names);
+    return m ? "abuopt: '" + first + "' is not a command; did you mean '" + *m + "'?" : "";
+  }
+  std::vector<std::string> flags = {"--help"};
+  for (const CLI::Option* o : sub->get_options())
+    for (const std::string& n : o->get_lnames()) flags.push_back("--" + n);
+  for (int i = 2; i < argc; ++i) {
+    std::string arg = argv[i];
+    if (arg == "--") break;
+    if (arg.rfind("--", 0) != 0) continue;
+    arg = arg.substr(0, arg.find('='));
+    if (std::find(flags.begin(), flags.end(), arg) != flags.end()) continue;
+    const auto m = closest_match(arg, flags);
+    return m ? "abuopt " + first + ": '" + arg + "' is not an option; did you mean '" + *m + "'?" : "";
+  }
+  return "";
+}
+
 }  // namespace abuopt::app
 
 int main(int argc, char** argv) {
@@ -30,6 +68,7 @@ int main(int argc, char** argv) {
       "design, an evaluation error ended it, out of memory); 4 an output file could not be written (disk\n"
       "full, no permission: nothing half-written is left under its name); 130 interrupted (Ctrl-C).\n"
       "docs/security.md says what abuopt trusts, where it writes and how it runs gnuplot."};
+  app.footer("\n" + abuopt::terms_text(""));
   app.require_subcommand(1);
   app.set_version_flag("--version", "abuopt 0.1.0");
   abuopt::app::register_simulate(app);
@@ -49,6 +88,7 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     app.exit(e);
+    if (const std::string hint = abuopt::app::hint_for(app, argc, argv); !hint.empty()) std::cerr << hint << "\n";
     return 2;
   } catch (const abuopt::ConfigError& e) {
     std::cerr << "abuopt: error: " << e.what() << "\n";

@@ -32,6 +32,7 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/output_file.hpp"
+#include "abuopt/common/progress.hpp"
 #include "abuopt/optimizer/benchmarking.hpp"
 #include "abuopt/optimizer/benchmarks/benchmark_factory.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
@@ -44,7 +45,7 @@ namespace {
 struct CompareArgs {
   std::string config;
   std::string out;
-  bool json = false;
+  bool json = false, progress = false;
 };
 
 // The budget, starts, seed, tolerance and reference value of any problem entry.
@@ -120,14 +121,19 @@ int run_compare(const CompareArgs& a) {
   std::size_t total = 0;
   for (const auto& p : setup.problems) total += static_cast<std::size_t>(p.starts) * setup.solvers.size();
   std::size_t done = 0;
+  ProgressReporter bar("compare", "runs", total, a.progress ? ProgressMode::Always : ProgressMode::Auto);
   setup.on_run = [&](const opt::RunRecord& r) {
     ++done;
-    std::cerr << "[" << done << "/" << total << "] " << r.problem << " start " << r.start << " " << r.solver << ": "
-              << r.result.brief_report() << "\n";
+    std::ostringstream line;
+    line << "[" << done << "/" << total << "] " << r.problem << " start " << r.start << " " << r.solver << ": "
+         << r.result.brief_report();
+    bar.message(line.str());
+    bar.update(done);
   };
   const std::string out = a.out.empty() ? "results/compare-" + timestamp() : a.out;
   const OutputDirLock lock(out);  // one run per output directory (created here)
   const opt::ComparisonResult result = opt::run_comparison(setup);
+  bar.finish();
 
   const opt::WrittenFiles files = opt::write_comparison(result, out);
 
@@ -181,11 +187,12 @@ void register_compare(CLI::App& app) {
       "compare",
       "Compare optimisers (NLopt algorithms, IPOPT, SAO) on benchmark problems from several starts, each\n"
       "with an evaluation budget: a table (solved runs, evaluations to reach tau, best value, feasibility,\n"
-      "time), convergence curves, data profiles and performance profiles (CSV, and PNG with gnuplot).\n"
+      "time), convergence curves, data profiles and performance profiles (CSV, and PNG + PDF with gnuplot).\n"
       "Exit status: 0 ok, 2 bad input.");
   sub->add_option("config", args->config, "YAML config (tau, problems, solvers; see configs/compare/)")->required();
   sub->add_option("--out", args->out, "output directory (default results/compare-<timestamp>/)");
   sub->add_flag("--json", args->json, "print one JSON object (runs and files) instead of the table");
+  sub->add_flag("--progress", args->progress, "show runs done, rate and ETA on stderr also when it is not a terminal");
   sub->callback([args] { set_exit_code(run_compare(*args)); });
 }
 

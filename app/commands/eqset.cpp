@@ -17,6 +17,8 @@
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/config_fields.hpp"
 #include "abuopt/common/gnuplot.hpp"
+#include "abuopt/common/plot_style.hpp"
+#include "abuopt/common/text.hpp"
 #include "abuopt/core/equilibrium_residual.hpp"
 #include "abuopt/core/equilibrium_set.hpp"
 #include "abuopt/core/simulation_config.hpp"
@@ -141,14 +143,14 @@ int run_single(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig&
     AtomicFile f(csv);
     f << "beta1_rad,beta2_rad,amplitude_mm,in_set";
     for (std::size_t b = 0; b < nb; ++b) f << ",margin_" << b + 1;
-    f << "\n" << std::setprecision(10);
+    f << "\n";
     for (std::size_t i = 0; i < n; ++i)
       for (std::size_t j = 0; j < n; ++j) {
         const std::size_t k = g.index(i, j);
         // With hard contact in_set is -1 where the balls overlap (excluded: not a configuration).
         const int in = !g.excluded.empty() && g.excluded[k] ? -1 : int(g.in_set[k]);
-        f << g.beta(i) << "," << g.beta(j) << "," << g.amplitude_mm[k] << "," << in;
-        for (std::size_t b = 0; b < nb; ++b) f << "," << g.margins[k * nb + b];
+        f << csv_number(g.beta(i)) << "," << csv_number(g.beta(j)) << "," << csv_number(g.amplitude_mm[k]) << "," << in;
+        for (std::size_t b = 0; b < nb; ++b) f << "," << csv_number(g.margins[k * nb + b]);
         f << "\n";
       }
     f.commit();
@@ -170,11 +172,11 @@ int run_single(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig&
     line = set.contact_line(freq, n);
     line_csv = dir / "contact_line.csv";
     AtomicFile f(line_csv);
-    f << "beta1_rad,beta2_rad,side,in_set\n" << std::setprecision(10);
+    f << "beta1_rad,beta2_rad,side,in_set\n";
     for (int side = 0; side < 2; ++side)
       for (std::size_t k = 0; k < n; ++k) {
         const double b1 = 2 * M_PI * static_cast<double>(k) / static_cast<double>(n);
-        f << b1 << "," << b1 + (side == 0 ? line->spacing_rad : -line->spacing_rad) << ","
+        f << csv_number(b1) << "," << csv_number(b1 + (side == 0 ? line->spacing_rad : -line->spacing_rad)) << ","
           << (side == 0 ? "ahead" : "behind") << "," << int(line->in_set[side][k]) << "\n";
       }
     f.commit();
@@ -186,22 +188,17 @@ int run_single(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig&
   plot.width_px = 820;
   plot.height_px = 760;
   std::ostringstream title;
-  title << "equilibrium set at " << freq << " Hz (W = " << std::setprecision(4) << set.speed_ratio(freq)
-        << ", mu = " << set.mu() << "): coverage " << std::setprecision(3) << g.coverage();
-  plot.labels = {title.str(), "beta_1 [rad]", "beta_2 [rad]"};
+  title << "Equilibrium set at " << freq << " Hz (W = " << std::setprecision(4) << set.speed_ratio(freq)
+        << ", μ = " << set.mu() << "): " << std::setprecision(3) << 100 * g.coverage() << " % of the grid in the set";
+  plot.labels = {title.str(), plot_style::kBeta1, plot_style::kBeta2};
+  plot.angle_axes = true;
   plot.fill_column = 4;
-  plot.palette = "defined (0 '#f4cccc', 1 '#b6d7a8')";
-  plot.cb_min = 0;
-  plot.cb_max = 1;
-  plot.cb_tics = "('outside' 0, 'in set' 1)";
-  if (!g.excluded.empty()) {
-    plot.palette = "defined (-1 '#999999', -0.33 '#999999', -0.33 '#f4cccc', 0.33 '#f4cccc', 0.33 '#b6d7a8', 1 '#b6d7a8')";
-    plot.cb_min = -1;
-    plot.cb_tics = "('overlap' -1, 'outside' 0, 'in set' 1)";
-  }
+  // A categorical key (not a colour scale): in the set, outside, overlapping balls (hard contact).
+  plot.categories = {{1, plot_style::kInSet, "in the equilibrium set"}, {0, plot_style::kOutOfSet, "outside it"}};
+  if (!g.excluded.empty()) plot.categories.push_back({-1, "#999999", "balls overlap (excluded)"});
   plot.contour_column = 3;
   plot.contour_levels = 8;
-  plot.contour_title = "steady amplitude [mm]";
+  plot.contour_title = "steady amplitude [mm] (contours)";
   const PlotStatus ps = Gnuplot().grid(plot);
 
   if (a.json) {
@@ -227,6 +224,7 @@ int run_single(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig&
                              {"coverage_behind", line->coverage(1)}, {"csv", line_csv.string()}};
     }
     j["png"] = plot.png_path;
+    j["pdf"] = ps.pdf_path;
     j["plot"] = {{"status", to_string(ps.state)}, {"message", ps.message}, {"script", ps.script_path}};
     std::cout << j.dump(2) << "\n";
   } else {
@@ -264,7 +262,8 @@ const char* kResidualHeader =
 
 double ir_units(double kgm) { return kgm / kIrUnit; }
 
-// One row of the residual table; NaN (empty statistics) written as "nan".
+// One row of the residual table; NaN where a statistic has no grid point (empty in the CSV, "-" in
+// the text table).
 std::vector<double> residual_row(const EquilibriumResidual& r) {
   return {r.frequency_hz,
           r.coverage,
@@ -309,26 +308,29 @@ int run_scan(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig& c
     const fs::path dir = make_out_dir(a.out, "--out");
     csv_path = (dir / "coverage.csv").string();
     AtomicFile f(csv_path);
-    f << "frequency_hz,coverage\n" << std::setprecision(10);
-    for (std::size_t k = 0; k < s.frequency_hz.size(); ++k) f << s.frequency_hz[k] << "," << s.coverage[k] << "\n";
+    f << "frequency_hz,coverage\n";
+    for (std::size_t k = 0; k < s.frequency_hz.size(); ++k)
+      f << csv_number(s.frequency_hz[k]) << "," << csv_number(s.coverage[k]) << "\n";
     f.commit();
     XYLinesPlot plot;
     plot.csv_path = csv_path;
     plot.png_path = (dir / "coverage.png").string();
     std::ostringstream title;
-    title << "equilibrium-set coverage (mu = " << set.mu() << ", natural frequency " << std::setprecision(4)
+    title << "Equilibrium-set coverage (μ = " << set.mu() << ", natural frequency " << std::setprecision(4)
           << set.natural_frequency_hz() << " Hz)";
-    plot.labels = {title.str(), "frequency [Hz]", "fraction of the (beta_1, beta_2) plane"};
+    plot.labels = {title.str(), plot_style::kFreqHz, "fraction of the (β_1, β_2) plane in the set"};
     plot.series = {{1, 2, "coverage", "linespoints"}};
     ps = Gnuplot().xy_lines(plot);
     plot_text = ps.ran() ? plot.png_path : ps.message;
 
     residual_csv = (dir / "residual.csv").string();
     AtomicFile r(residual_csv);
-    r << kResidualHeader << "\n" << std::setprecision(10);
+    r << kResidualHeader << "\n";
     for (const auto& e : res) {
       const auto row = residual_row(e);
-      for (std::size_t c = 0; c < row.size(); ++c) r << (c ? "," : "") << row[c];
+      // An empty field: no grid point in that part at this frequency (e.g. the boundary columns
+      // outside the band, where the whole plane is in the set).
+      for (std::size_t c = 0; c < row.size(); ++c) r << (c ? "," : "") << (std::isfinite(row[c]) ? csv_number(row[c]) : "");
       r << "\n";
     }
     r.commit();
@@ -336,9 +338,11 @@ int run_scan(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig& c
     rp.csv_path = residual_csv;
     rp.png_path = (dir / "residual.png").string();
     std::ostringstream rt;
-    rt << "residual imbalance the equilibrium set allows (mu = " << set.mu() << ", r_lock = " << std::setprecision(3)
-       << locked << "e-7 kg m)";
-    rp.labels = {rt.str(), "frequency [Hz]", "|I_r| [1e-7 kg m]"};
+    rt << "Residual imbalance the equilibrium set allows (μ = " << set.mu() << ", r_{lock} = " << std::setprecision(3)
+       << locked << "·10^{-7} kg m)";
+    rp.labels = {rt.str(), plot_style::kFreqHz, plot_style::kIr};
+    rp.key = "outside below";
+    rp.height_px = 760;
     rp.series = {{1, 3, "r_in (closed form: all |I_r| below are in the set)", "lines"},
                  {1, 5, "median |I_r| over the set", "lines"},
                  {1, 4, "min |I_r| over the set", "lines"},
@@ -384,7 +388,8 @@ int run_scan(const EqsetArgs& a, const EquilibriumSet& set, const EqsetConfig& c
                  "part's edge\n";
     std::cout << "# frequency_hz coverage r_in set_ir_min set_ir_median set_ir_max set_irx_median balance_fraction "
                  "balance_ir_median boundary_ir_min boundary_ir_median\n";
-    auto col = [](double v) {
+    auto col = [](double v) {  // "-": no grid point in that part (the boundary outside the band)
+      if (!std::isfinite(v)) return std::string("-");
       std::ostringstream os;
       os << std::setprecision(4) << v;
       return os.str();
@@ -461,10 +466,11 @@ void register_eqset(CLI::App& app) {
       "eqset",
       "Equilibrium set at constant speed (report fig 4.3): the ball angles (beta_1, beta_2) where all balls\n"
       "can stay stuck, with the steady vibration amplitude there.\n"
-      "  --freq HZ: writes DIR/equilibrium_set.csv and .png (set and amplitude contours); prints coverage\n"
+      "  --freq HZ: writes DIR/equilibrium_set.csv, .png and .pdf (set and amplitude contours); prints coverage\n"
       "  --scan FROM:TO:STEP: prints per frequency the coverage and the residual imbalance the set allows\n"
       "    (smallest/median/largest |I_r|, I_r,x over the set and around the balancing points), the band\n"
-      "    where the coverage is below 1; with --out also residual.csv/.png.\n"
+      "    where the coverage is below 1; with --out also residual.csv/.png/.pdf. '-' (an empty CSV field): that\n"
+      "    part has no grid point (the boundary columns outside the band, where the set is the plane).\n"
       "Exit status: 0 ok, 2 bad input.");
   sub->add_option("config", args->config, "YAML config (section abu; optional section eqset)")->required();
   auto* freq = sub->add_option("--freq", args->freq, "constant speed in Hz (> 0)");

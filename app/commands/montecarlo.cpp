@@ -15,10 +15,15 @@
 #include <nlohmann/json.hpp>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/common/gnuplot.hpp"
 #include "abuopt/common/output_file.hpp"
+#include "abuopt/common/plot_style.hpp"
+#include "abuopt/common/text.hpp"
+#include "abuopt/common/progress.hpp"
 #include "abuopt/core/monte_carlo.hpp"
 #include "abuopt/core/monte_carlo_stats.hpp"
 #include "abuopt/core/simulation_config.hpp"
+#include "abuopt/studies/terms.hpp"
 #include "commands/commands.hpp"
 
 namespace abuopt::app {
@@ -31,7 +36,7 @@ struct MonteCarloArgs {
   std::optional<long long> seed;
   std::optional<double> mu;
   std::optional<std::string> design;
-  bool json = false;
+  bool json = false, progress = false;
   std::string out;
 };
 
@@ -118,33 +123,40 @@ nlohmann::json study_json(const MonteCarloArgs& a, const MonteCarloConfig& cfg, 
   return j;
 }
 
-// A one-line progress bar on stderr, redrawn at most every 0.1 s: runs done, rate, ETA.
-class ProgressBar {
- public:
-  void operator()(std::size_t done, std::size_t total, double elapsed) {
-    if (done < total && elapsed - last_ < 0.1) return;
-    last_ = elapsed;
-    const double frac = total ? static_cast<double>(done) / static_cast<double>(total) : 1.0;
-    const int width = 30, filled = static_cast<int>(frac * width);
-    const double rate = elapsed > 0 ? static_cast<double>(done) / elapsed : 0.0;
-    std::fprintf(stderr, "\r[%s%s] %zu/%zu runs  %.1f runs/s  ", std::string(filled, '#').c_str(),
-                 std::string(width - filled, ' ').c_str(), done, total, rate);
-    if (done < total && rate > 0)
-      std::fprintf(stderr, "ETA %.0f s   ", static_cast<double>(total - done) / rate);
-    else if (done == total)
-      std::fprintf(stderr, "done in %.1f s\n", elapsed);
-    std::fflush(stderr);
-  }
+// residual_histogram.png/.pdf: both residual-imbalance definitions of every ok run (from runs.csv,
+// by column name), 40 bins from 0 to the largest |I_r|, with the %MI threshold I = m_I e.
+PlotStatus plot_residual_histogram(const std::string& dir, const MonteCarloResult& result, double imbalance_kgm,
+                                   const std::string& what) {
+  std::size_t ok = 0;
+  for (const MonteCarloSample& smp : result.samples) ok += smp.outcome.ok() ? 1 : 0;
+  const double threshold = imbalance_kgm * 1e7;
+  std::ostringstream b;
+  b << "set datafile separator ','\nset datafile columnheaders\n"
+    << "set title " << plot_style::literal("Residual imbalance of " + std::to_string(ok) + " runs (" + what + ")") << "\n"
+    << "set xlabel 'residual imbalance [10^{-7} kg m]'\nset ylabel 'runs per bin'\n"
+    << "ir(c) = (strcol('status') eq 'ok') ? column(c) * 1e7 : NaN\n"
+    << "stats 'runs.csv' using (ir('ir_magnitude_kgm')) nooutput\n"
+    << "w = STATS_max > 0 ? STATS_max / 40 : 1\n"
+    << "bin(x) = w * (floor(x / w) + 0.5)\n"
+    << "set boxwidth w\nset style fill transparent solid 0.45 border\nset xrange [0:*]\nset yrange [0:*]\n"
+    << "set grid\nset key top left\n"
+    << "set arrow 1 from " << format_number(threshold) << ", graph 0 to " << format_number(threshold)
+    << ", graph 1 nohead dt 2 lw 2 lc rgb '" << plot_style::kRed << "'\n"
+    << "plot 'runs.csv' using (bin(ir('ir_magnitude_kgm'))):(1.0) smooth frequency with boxes lt 1 title '|I_r|', \\\n"
+    << "     '' using (bin(ir('ir_x_kgm'))):(1.0) smooth frequency with boxes lt 2 title 'I_{r,x} (report eq. 4.2)', \\\n"
+    << "     NaN with lines dt 2 lw 2 lc rgb '" << plot_style::kRed << "' title 'I = m_I e (%MI threshold)'\n";
+  const std::filesystem::path d(dir);
+  return Gnuplot().run(b.str(), (d / "residual_histogram.gp").string(), (d / "residual_histogram.png").string(), 900,
+                       600);
+}
 
- private:
-  double last_ = -1.0;
-};
-
-void write_outputs(const std::string& dir, const MonteCarloResult& result, const nlohmann::json& summary) {
+PlotStatus write_outputs(const std::string& dir, const MonteCarloResult& result, const nlohmann::json& summary,
+                         double imbalance_kgm, const std::string& what) {
   AtomicFile csv(std::filesystem::path(dir) / "runs.csv");
   write_runs_csv(csv.stream(), result.samples);
   csv.commit();
   write_file_atomic(std::filesystem::path(dir) / "summary.json", summary.dump(2) + "\n");
+  return plot_residual_histogram(dir, result, imbalance_kgm, what);
 }
 
 int run_montecarlo(const MonteCarloArgs& a) {
@@ -164,14 +176,25 @@ int run_montecarlo(const MonteCarloArgs& a) {
   const double end_time_s = sim->end_time_s();
   ThreadPoolRunner runner(cfg.threads);
 
+  ProgressReporter bar("Monte Carlo", "runs", s.runs, a.progress ? ProgressMode::Always : ProgressMode::Auto);
   ProgressCallback progress;
-  if (isatty(fileno(stderr))) progress = ProgressBar{};
+  if (bar.enabled())
+    progress = [&bar](std::size_t done, std::size_t total, double) {
+      bar.set_total(total);
+      bar.update(done);
+    };
   const MonteCarloResult result = run_monte_carlo(s, sample, runner, progress);
+  bar.finish();
   const MonteCarloStats stats = compute_statistics(result);
 
   nlohmann::json summary = to_json(stats);
   summary["study"] = study_json(a, cfg, end_time_s);
-  if (!a.out.empty()) write_outputs(a.out, result, summary);
+  PlotStatus plot;
+  if (!a.out.empty()) {
+    std::ostringstream what;
+    what << to_string(study_design(s).kind) << " design, seed " << s.seed << ", μ = " << friction_text(s);
+    plot = write_outputs(a.out, result, summary, s.setup.abu.imbalance_kgm(), what.str());
+  }
 
   if (a.json) {
     std::cout << summary.dump(2) << "\n";
@@ -186,7 +209,10 @@ int run_montecarlo(const MonteCarloArgs& a) {
               << " s, imbalance without balls I = " << std::setprecision(4) << s.setup.abu.imbalance_kgm() * 1e7
               << "e-7 kg m\n"
               << std::setprecision(6) << format_summary(stats);
-    if (!a.out.empty()) std::cout << "wrote " << a.out << "/runs.csv and " << a.out << "/summary.json\n";
+    std::cout << terms_text("");
+    if (!a.out.empty())
+      std::cout << "wrote " << a.out << "/runs.csv and " << a.out << "/summary.json\n"
+                << (plot.ran() ? "plot: " + plot.png_path + " and " + plot.pdf_path : "plot " + plot.message) << "\n";
   }
   if (stats.ok == 0) {
     std::cerr << "abuopt: every run failed (" << stats.failed << " of " << s.runs
@@ -207,6 +233,7 @@ void register_montecarlo(CLI::App& app) {
       "95 % Wilson interval, %LC, settling time, peak amplitude, failed runs. Uses all cores; results do\n"
       "not depend on the thread count. Options override the config's `montecarlo` section.\n"
       "Exit status: 0 ok, 2 bad input, 3 every run failed.");
+  sub->footer("\n" + terms_text(""));
   sub->add_option("config", args->config, "YAML config (sections abu, profile, motor, simulation, montecarlo)")
       ->required();
   sub->add_option("--runs", args->runs, "number of runs (grid design: must equal grid^balls)");
@@ -215,8 +242,12 @@ void register_montecarlo(CLI::App& app) {
   sub->add_option("--seed", args->seed, "seed of the design and of the uncertain parameters");
   sub->add_option("--threads", args->threads, "worker threads (0 = all cores)");
   sub->add_option("--mu", args->mu, "fixed friction coefficient for every run (overrides montecarlo.friction)");
+  sub->add_flag("--progress", args->progress,
+                "show runs done, rate and ETA on stderr also when it is not a terminal (on a terminal: always)");
   sub->add_flag("--json", args->json, "print one JSON object (summary and study) instead of the text summary");
-  sub->add_option("--out", args->out, "write runs.csv (one line per run) and summary.json into this directory");
+  sub->add_option("--out", args->out,
+                  "write runs.csv (one line per run), summary.json and residual_histogram.png/.pdf (both I_r\n"
+                  "definitions, with the %MI threshold; gnuplot script beside it) into this directory");
   sub->callback([args] { set_exit_code(run_montecarlo(*args)); });
 }
 

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <optional>
 #include <set>
@@ -18,6 +19,8 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/gnuplot.hpp"
+#include "abuopt/common/plot_style.hpp"
+#include "abuopt/common/progress.hpp"
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/text.hpp"
 #include "abuopt/core/simulation_config.hpp"
@@ -27,6 +30,7 @@
 #include "abuopt/optimizer/penalty_problem.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
 #include "abuopt/studies/out_of_sample.hpp"
+#include "abuopt/studies/terms.hpp"
 #include "commands/commands.hpp"
 
 namespace abuopt::app {
@@ -40,7 +44,7 @@ using problems::StartupProfileProblem;
 struct OptimizeArgs {
   std::string config;
   std::string out;
-  bool json = false;
+  bool json = false, progress = false;
   std::optional<long> max_evaluations;
   std::optional<long> threads;
 };
@@ -97,8 +101,21 @@ nlohmann::json profile_json(const StartupProfile& p) {
   return {{"start_frequency_hz", p.start_frequency_hz()}, {"segments", segs}, {"duration_s", p.duration_s()}};
 }
 
+// Metrics as JSON: the counts (runs, failed runs) as integers, the rest as numbers.
+nlohmann::json metrics_json(const std::map<std::string, double>& metrics) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& [k, v] : metrics) {
+    const bool count = k == "runs" || k == "failed_runs";
+    if (count && std::isfinite(v) && v == std::floor(v) && std::fabs(v) < 9e15)
+      j[k] = static_cast<long long>(v);
+    else
+      j[k] = v;
+  }
+  return j;
+}
+
 nlohmann::json evaluation_json(const opt::Evaluation& e, const std::vector<std::string>& names) {
-  nlohmann::json j = {{"ok", e.ok}, {"objective", e.objective}, {"metrics", e.metrics}};
+  nlohmann::json j = {{"ok", e.ok}, {"objective", e.objective}, {"metrics", metrics_json(e.metrics)}};
   if (!e.message.empty()) j["message"] = e.message;
   nlohmann::json g = nlohmann::json::object();
   for (std::size_t i = 0; i < e.inequality.size() && i < names.size(); ++i) g[names[i]] = e.inequality[i];
@@ -134,8 +151,9 @@ void write_history_csv(const fs::path& path, const opt::OptimizationResult& r) {
   f.commit();
 }
 
-// convergence.csv (+ .png): objective of every evaluation, of the feasible ones, best feasible so far.
-std::string write_convergence(const fs::path& dir, const opt::OptimizationResult& r) {
+// convergence.csv (+ .png and .pdf): objective of every evaluation, of the feasible ones, best
+// feasible so far. Returns the plot's status (its PNG and PDF paths when made).
+PlotStatus write_convergence(const fs::path& dir, const opt::OptimizationResult& r) {
   const fs::path csv = dir / "convergence.csv", png = dir / "convergence.png";
   {
     AtomicFile f(csv);
@@ -149,16 +167,21 @@ std::string write_convergence(const fs::path& dir, const opt::OptimizationResult
     }
     f.commit();
   }
-  Gnuplot gp;
-  if (!gp.available()) return "convergence plot skipped: gnuplot not found (data in " + csv.string() + ")";
   XYLinesPlot p;
-  p.csv_path = fs::absolute(csv).string();
-  p.png_path = fs::absolute(png).string();
-  p.labels = {"convergence: " + r.algorithm + " on " + r.problem_name, "evaluation", "objective"};
-  p.series = {{1, 2, "every evaluation", "points"}, {1, 3, "feasible", "points"}, {1, 4, "best feasible so far", "steps"}};
-  const PlotStatus s = gp.xy_lines(p);
-  if (s.ran()) return "wrote " + png.string();
-  return "convergence plot " + s.message + " (data in " + csv.string() + ")";
+  p.csv_path = csv.string();
+  p.png_path = png.string();
+  p.labels = {"Convergence of " + plot_style::escape(r.algorithm) + " on " + plot_style::escape(r.problem_name),
+              "evaluation", "objective"};
+  p.series = {{1, 2, "every evaluation", "points pt 6 ps 1.6"},
+              {1, 3, "feasible", "points pt 7 ps 0.8"},
+              {1, 4, "best feasible so far", "steps"}};
+  return Gnuplot().xy_lines(p);
+}
+
+// One line for the log: where the plot is, or why not.
+std::string convergence_text(const PlotStatus& s) {
+  if (s.ran()) return "wrote " + s.png_path + " and " + s.pdf_path;
+  return "convergence plot " + s.message;
 }
 
 void write_best_profile(const fs::path& path, const StartupProfileProblem& problem, const opt::OptimizationResult& r,
@@ -210,6 +233,9 @@ int run_optimize(const OptimizeArgs& a) {
     log << "  " << vars[i].name << " in [" << format_number(vars[i].lower) << ", " << format_number(vars[i].upper)
         << "], x0 " << format_number(problem.initial_point()[i]) << "\n";
 
+  // The bar (stderr) counts evaluations against the budget; the log lines go around it.
+  ProgressReporter bar("optimize", "evaluations", static_cast<std::size_t>(std::max(0L, cfg.options.max_evaluations)),
+                       a.progress ? ProgressMode::Always : ProgressMode::Auto);
   const opt::EvaluationCallback progress = [&](const opt::Progress& p) {
     const auto& r = p.last;
     std::ostringstream os;
@@ -230,11 +256,14 @@ int run_optimize(const OptimizeArgs& a) {
       os << "none";
     os << (r.from_archive ? "  [archive]" : "  [computed " + format_number(std::round(r.wall_time_s * 10) / 10) + " s]");
     if (r.for_gradient) os << " [fd]";
-    log << os.str() << "\n" << std::flush;
+    log << std::flush;
+    bar.message(os.str(), a.json ? stderr : stdout);
+    bar.update(static_cast<std::size_t>(std::max(0L, static_cast<long>(p.evaluations))));
     return true;
   };
 
   opt::OptimizationResult r = opt::minimize(archived, cfg.options, {}, progress);
+  bar.finish();
   log << "\n" << r.brief_report() << "\n";
   if (!r.message.empty()) log << "  " << r.message << "\n";
 
@@ -278,7 +307,7 @@ int run_optimize(const OptimizeArgs& a) {
                  {"feasible", r.feasible},
                  {"max_violation", r.max_violation},
                  {"constraints", bg},
-                 {"metrics", r.metrics},
+                 {"metrics", metrics_json(r.metrics)},
                  {"profile", profile_json(problem.profile_at(r.x))}};
     log << "best design: " << vector_text(vars, r.x) << "\n  profile " << profile_text(problem.profile_at(r.x))
         << "\n  objective " << format_number(r.objective) << (r.feasible ? " (feasible)" : " (NOT feasible)") << "\n";
@@ -299,13 +328,17 @@ int run_optimize(const OptimizeArgs& a) {
 
   // Files first (a Ctrl-C during the validation below still leaves them), result.json again after it.
   write_history_csv(out / "history.csv", r);
-  const std::string plot_message = write_convergence(out, r);
+  const PlotStatus plot = write_convergence(out, r);
   if (have_best) write_best_profile(out / "best_profile.yaml", problem, r, a.config);
   j["files"] = {{"history", (out / "history.csv").string()},
                 {"convergence_csv", (out / "convergence.csv").string()},
                 {"archive", (out / "archive.sqlite").string()}};
   if (have_best) j["files"]["best_profile"] = (out / "best_profile.yaml").string();
-  j["convergence_plot"] = plot_message;
+  if (plot.ran()) {
+    j["files"]["convergence_png"] = plot.png_path;
+    j["files"]["convergence_pdf"] = plot.pdf_path;
+  }
+  j["convergence_plot"] = {{"status", to_string(plot.state)}, {"message", plot.message}, {"script", plot.script_path}};
   const fs::path result_json = out / "result.json";
   auto write_json = [&] { write_file_atomic(result_json, j.dump(2) + "\n"); };
   write_json();
@@ -319,7 +352,7 @@ int run_optimize(const OptimizeArgs& a) {
     const OutOfSampleComparison cmp = compare_out_of_sample(problem, r, penalised ? &*penalised : nullptr);
     const StartupProfile& report = cmp.report;
     const std::vector<ComparisonRow>& rows = cmp.rows;
-    log << comparison_table(rows);
+    log << comparison_table(rows) << terms_text("  ");
     log << "  report profile: " << profile_text(report) << "\n";
     j["validation"] = {{"runs", v.runs},
                        {"design", to_string(v.design)},
@@ -336,7 +369,7 @@ int run_optimize(const OptimizeArgs& a) {
 
   log << "wrote " << (out / "history.csv").string() << ", " << result_json.string()
       << (have_best ? ", " + (out / "best_profile.yaml").string() : std::string()) << "\n"
-      << plot_message << "\n";
+      << convergence_text(plot) << "\n";
   if (a.json) std::cout << j.dump(2) << "\n";
   if (interrupted) return 130;
   if (r.reason == opt::TerminationReason::EvaluationError) {
@@ -366,12 +399,15 @@ void register_optimize(CLI::App& app) {
       "and the report's final profile are evaluated on a fresh, larger set of initial conditions.\n"
       "Exit status: 0 ok, 2 bad input, 3 no feasible design found or the run ended on an evaluation\n"
       "error (the reason is printed), 4 an output file could not be written, 130 interrupted (Ctrl-C).");
+  sub->footer("\n" + terms_text(""));
   sub->add_option("config", args->config,
                   "YAML config (abu, profile, motor, simulation, montecarlo, design, objective, constraints,\n"
                   "validation, optimizer, sao); see configs/optimize/ and docs/optimize.md")
       ->required();
   sub->add_option("--out", args->out, "output directory (default results/<config stem>)");
   sub->add_flag("--json", args->json, "print result.json to stdout (progress goes to stderr)");
+  sub->add_flag("--progress", args->progress,
+                "show evaluations done of the budget, rate and ETA on stderr also when it is not a terminal");
   sub->add_option("--max-evaluations", args->max_evaluations, "evaluation budget (overrides optimizer.max_evaluations)");
   sub->add_option("--threads", args->threads, "Monte Carlo worker threads (0 = all cores; overrides montecarlo.threads)");
   sub->callback([args] { set_exit_code(run_optimize(*args)); });

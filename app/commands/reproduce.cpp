@@ -14,7 +14,9 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/output_file.hpp"
+#include "abuopt/common/progress.hpp"
 #include "abuopt/studies/reproduction.hpp"
+#include "abuopt/studies/terms.hpp"
 #include "commands/commands.hpp"
 
 namespace abuopt::app {
@@ -27,7 +29,7 @@ struct ReproduceArgs {
   std::optional<long> runs, threads;
   std::vector<std::string> only;
   std::string out, configs;
-  bool no_plots = false;
+  bool no_plots = false, progress = false;
 };
 
 // The study files: --configs, else configs/report below the working directory, else beside the
@@ -85,14 +87,16 @@ int run_reproduce(const ReproduceArgs& a) {
   opt.plots = !a.no_plots;
   opt.command_line = command_line(a, opt.out_dir);
   if (a.runs) opt.runs_note = override_runs(tables, static_cast<std::size_t>(*a.runs), "--runs");
-  opt.log = [](const std::string& line) { std::cerr << line << std::endl; };
-
-  std::size_t cases = 0, runs = 0;
+  std::size_t cases = 0, runs = 0, all_runs = 0;  // all_runs: with the contact variants
   for (const ReproductionTable& t : tables)
     for (const ReproductionCase& c : t.cases) {
       ++cases;
       runs += c.study.runs;
+      all_runs += c.study.runs * (t.contact_variant ? 2 : 1);
     }
+  ProgressReporter bar("reproduce", "runs", all_runs, a.progress ? ProgressMode::Always : ProgressMode::Auto);
+  opt.log = [&bar](const std::string& line) { bar.message(line); };
+  opt.progress = [&bar](std::size_t done, std::size_t) { bar.update(done); };
   std::cout << "Reproducing the 2003 report: " << tables.size() << " table" << (tables.size() == 1 ? "" : "s") << ", "
             << cases << " cases, " << runs << " runs (study files: " << dir << ")\n";
   if (!opt.runs_note.empty()) std::cout << opt.runs_note << "\n";
@@ -101,6 +105,7 @@ int run_reproduce(const ReproduceArgs& a) {
 
   const OutputDirLock lock(opt.out_dir);  // one run per output directory
   const ReproductionReport r = run_reproduction(tables, opt);
+  bar.finish();
 
   std::cout << "\n";
   for (const TableResult& t : r.tables) std::cout << format_table_text(t) << "\n";
@@ -109,8 +114,9 @@ int run_reproduce(const ReproduceArgs& a) {
                "direction holds on the point estimates only):\n";
   if (verdicts.empty()) std::cout << "  (none: the tables that carry them were not run)\n";
   for (const Verdict& v : verdicts) std::cout << "  " << v.one_line() << "\n";
+  std::cout << terms_text("");
   if (!r.plots.empty()) {
-    std::cout << "Plots:\n";
+    std::cout << "Plots (PNG; a PDF and the gnuplot script beside each):\n";
     for (const PlotNote& p : r.plots) std::cout << "  " << p.name << ": " << (p.made ? p.png : p.message) << "\n";
   }
   std::cout << "Wall time " << static_cast<long>(r.wall_time_s * 10) / 10.0 << " s on " << r.concurrency << " thread"
@@ -139,6 +145,7 @@ void register_reproduce(CLI::App& app) {
       "verdict per published conclusion. Writes per-case run CSVs (as each case ends), tables.csv,\n"
       "report.md and plots into --out. Exit status: 0 ok, 2 bad input, 3 every run of some case failed,\n"
       "4 an output file could not be written.");
+  sub->footer("\n" + terms_text(""));
   sub->add_option("--runs", args->runs,
                   "runs per case for every case: an n x n grid with n = round(sqrt(N)) (default: the report's counts)");
   sub->add_option("--only", args->only, "comma-separated table ids: 4.1, 4.2, 4.3, 4.4, final, mu (default: all)")
@@ -147,6 +154,8 @@ void register_reproduce(CLI::App& app) {
   sub->add_option("--out", args->out, "output directory (default results/reproduce-<timestamp>)");
   sub->add_option("--configs", args->configs, "directory of the study files (default: configs/report)");
   sub->add_flag("--no-plots", args->no_plots, "skip the plots");
+  sub->add_flag("--progress", args->progress,
+                "show runs done, rate and ETA on stderr also when it is not a terminal (on a terminal: always)");
   sub->callback([args] { set_exit_code(run_reproduce(*args)); });
 }
 

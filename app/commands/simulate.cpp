@@ -87,10 +87,10 @@ int run_simulate(const SimulateArgs& a) {
     f << "t_s,frequency_hz,x_m,y_m";
     for (std::size_t i = 0; i < n; ++i) f << ",beta" << i + 1 << "_rad";
     for (std::size_t i = 0; i < n; ++i) f << ",mode" << i + 1;
-    f << "\n" << std::setprecision(10);
-    for (const auto& p : traj) {
-      f << p.t_s << "," << p.frequency_hz << "," << p.x_m << "," << p.y_m;
-      for (double b : p.beta) f << "," << b;
+    f << "\n";
+    for (const auto& p : traj) {  // shortest round-trip numbers
+      f << csv_number(p.t_s) << "," << csv_number(p.frequency_hz) << "," << csv_number(p.x_m) << "," << csv_number(p.y_m);
+      for (double b : p.beta) f << "," << csv_number(b);
       for (int m : p.mode) f << "," << m;
       f << "\n";
     }

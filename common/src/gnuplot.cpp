@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <cstdio>
@@ -16,6 +17,7 @@
 #include <stdexcept>
 
 #include "abuopt/common/output_file.hpp"
+#include "abuopt/common/plot_style.hpp"
 
 namespace abuopt {
 
@@ -172,18 +174,24 @@ std::string Gnuplot::beside_csv(const PlotFiles& f, const std::string& suffix) {
   return (csv.parent_path() / (png.stem().string() + suffix)).string();
 }
 
+std::string Gnuplot::relative_to(const std::string& path, const std::string& dir) {
+  std::error_code ec;
+  const fs::path base = fs::absolute(dir.empty() ? fs::path(".") : fs::path(dir), ec);
+  const fs::path rel = fs::absolute(path, ec).lexically_normal().lexically_relative(base.lexically_normal());
+  return rel.empty() ? path : rel.string();
+}
+
 PlotStatus Gnuplot::run(const std::string& script_body, const std::string& script_path, const std::string& png_path,
                         int width_px, int height_px) const {
   PlotStatus st;
   st.script_path = script_path;
   st.png_path = png_path;
-  std::ostringstream s;
-  s << "# written by abuopt; run with: gnuplot " << fs::path(script_path).filename().string() << "\n"
-    << "set terminal " << (available() ? terminal() : std::string("pngcairo")) << " noenhanced size " << width_px
-    << "," << height_px << "\n"
-    << "set output " << quote(png_path) << "\n"
-    << script_body;
-  write_file_atomic(script_path, s.str());  // throws OutputError
+  st.pdf_path = fs::path(png_path).replace_extension(".pdf").string();
+  const std::string dir = fs::path(script_path).parent_path().string();
+  const std::string png_rel = relative_to(png_path, dir);
+  const std::string stem = fs::path(png_rel).replace_extension("").string();
+  write_file_atomic(script_path, plot_style::figure_script(stem, script_body, width_px, height_px,
+                                                           available() ? terminal() : std::string("pngcairo")));
   if (!available()) {
     st.state = PlotStatus::State::Skipped;
     st.message = "skipped: gnuplot not found (script written to " + script_path + ")";
@@ -192,11 +200,14 @@ PlotStatus Gnuplot::run(const std::string& script_body, const std::string& scrip
   const std::string log_path = (fs::path(script_path).replace_extension(".log")).string();
   std::error_code ec;
   fs::remove(png_path, ec);
-  const int rc = run_script(script_path, "", log_path);
-  const bool made = fs::is_regular_file(png_path, ec) && fs::file_size(png_path, ec) > 0;
+  fs::remove(st.pdf_path, ec);
+  // In the script's folder, by its file name: the script's relative paths are what runs.
+  const int rc = run_script(fs::path(script_path).filename().string(), dir, fs::absolute(log_path, ec).string());
+  const bool made = fs::is_regular_file(png_path, ec) && fs::file_size(png_path, ec) > 0 &&
+                    fs::is_regular_file(st.pdf_path, ec) && fs::file_size(st.pdf_path, ec) > 0;
   if (rc != 0 || !made) {
     st.state = PlotStatus::State::Failed;
-    st.message = "failed: gnuplot " + std::string(rc == -1 ? "could not be run" : rc != 0 ? "exited with status " + std::to_string(rc) : "made no PNG") +
+    st.message = "failed: gnuplot " + std::string(rc == -1 ? "could not be run" : rc != 0 ? "exited with status " + std::to_string(rc) : "made no PNG and PDF") +
                  " (" + log_path + "): " + read_text(log_path, 400);
     return st;
   }
@@ -226,7 +237,9 @@ std::string Gnuplot::xy_lines_body(const XYLinesPlot& p) {
   std::ostringstream s;
   s << "set datafile separator ','\n";
   labels_lines(s, p.labels);
-  s << "set grid\nset key top left\n";
+  s << "set grid\nset key " << p.key << "\n";
+  if (p.angle_x) s << plot_style::angle_axis("x");
+  if (p.angle_y) s << plot_style::angle_axis("y");
   if (p.log_x) s << "set logscale x\n";
   if (p.log_y) s << "set logscale y\n";
   s << "plot ";
@@ -235,8 +248,14 @@ std::string Gnuplot::xy_lines_body(const XYLinesPlot& p) {
     require_column(se.x_column, "x_column");
     require_column(se.y_column, "y_column");
     s << (k ? ", \\\n     " : "") << quote(p.csv_path) << " skip " << p.header_lines << " using "
-      << se.x_column << ":" << se.y_column << " with " << se.style << " lw 2 "
-      << (se.title.empty() ? "notitle" : "title " + quote(se.title));
+      << se.x_column << ":" << se.y_column;
+    if (se.error_column > 0) s << ":" << se.error_column;
+    // The series' colour (lt) right after the style's name, so options in the style (pt, ps)
+    // override the linetype's defaults.
+    const std::size_t sp = se.style.find(' ');
+    s << " with " << se.style.substr(0, sp) << " lt " << k + 1
+      << (sp == std::string::npos ? std::string() : se.style.substr(sp)) << " "
+      << (se.title.empty() ? "notitle" : "title " + plot_style::literal(se.title));
   }
   s << "\n";
   return s.str();
@@ -250,6 +269,7 @@ std::string Gnuplot::scatter_body(const ScatterPlot& p) {
   labels_lines(s, p.labels);
   s << "set grid\nunset key\n";
   if (p.color_column > 0 && !p.color_label.empty()) s << "set cblabel " << quote(p.color_label) << "\n";
+  if (p.angle_axes) s << plot_style::angle_axis("x") << plot_style::angle_axis("y") << "set size square\n";
   s << "plot " << quote(p.csv_path) << " skip " << p.header_lines << " using " << p.x_column << ":" << p.y_column;
   if (p.color_column > 0) s << ":" << p.color_column;
   s << " with points pt 7 ps " << p.point_size << (p.color_column > 0 ? " palette" : "") << "\n";
@@ -265,11 +285,30 @@ std::string Gnuplot::grid_body(const GridPlot& p, const std::string& grid_data_p
   labels_lines(s, p.labels);
   s << "set view map\n";
   if (p.square) s << "set size square\n";
-  s << "set autoscale fix\nset tics out\nset key at screen 0.5, 0.03 center horizontal\nset bmargin 5\n";
-  if (!p.palette.empty()) s << "set palette " << p.palette << "\n";
-  if (p.cb_max > p.cb_min) s << "set cbrange [" << p.cb_min << ":" << p.cb_max << "]\n";
-  if (!p.cb_tics.empty()) s << "set cbtics " << p.cb_tics << "\n";
-  if (!p.fill_label.empty()) s << "set cblabel " << quote(p.fill_label) << "\n";
+  // The key centred below the plot.
+  s << "set autoscale fix\nset tics out\nset key at screen 0.5, 0.1 center center horizontal maxcols 3\nset bmargin 7\n";
+  // One turn on each axis (the image ends half a cell before 2 pi: a sliver of the background).
+  if (p.angle_axes) s << plot_style::angle_axis("x") << plot_style::angle_axis("y");
+  std::string key_entries;  // the categories' key: a filled square each (splot draws no NaN boxes)
+  if (!p.categories.empty()) {
+    int lo = p.categories.front().value, hi = lo;
+    for (const auto& c : p.categories) lo = std::min(lo, c.value), hi = std::max(hi, c.value);
+    s << "set palette defined (";
+    for (int v = lo; v <= hi; ++v) {
+      std::string colour = "#ffffff";
+      for (const auto& c : p.categories)
+        if (c.value == v) colour = c.colour;
+      s << (v > lo ? ", " : "") << v - 0.5 << " '" << colour << "', " << v + 0.5 << " '" << colour << "'";
+    }
+    s << ")\nset cbrange [" << lo - 0.5 << ":" << hi + 0.5 << "]\nunset colorbox\n";
+    for (const auto& c : p.categories)
+      key_entries += ", \\\n      NaN with points pt 5 ps 2.5 lc rgb '" + c.colour + "' title " + quote(c.label);
+  } else {
+    if (!p.palette.empty()) s << "set palette " << p.palette << "\n";
+    if (p.cb_max > p.cb_min) s << "set cbrange [" << p.cb_min << ":" << p.cb_max << "]\n";
+    if (!p.cb_tics.empty()) s << "set cbtics " << p.cb_tics << "\n";
+    if (!p.fill_label.empty()) s << "set cblabel " << quote(p.fill_label) << "\n";
+  }
   const std::string data = quote(grid_data_path);
   const std::string xy = std::to_string(p.x_column) + ":" + std::to_string(p.y_column) + ":";
   if (p.contour_column > 0) {
@@ -278,9 +317,10 @@ std::string Gnuplot::grid_body(const GridPlot& p, const std::string& grid_data_p
     s << "splot " << data << " using " << xy << p.fill_column << " with image nocontour notitle, \\\n"
       << "      " << data << " using " << xy << p.contour_column << " nosurface with lines lc rgb 'black' lw 1 "
       << (p.contour_title.empty() ? "notitle" : "title " + quote(p.contour_title)) << ", \\\n"
-      << "      " << data << " using " << xy << p.contour_column << " nosurface with labels notitle\n";
+      << "      " << data << " using " << xy << p.contour_column << " nosurface with labels notitle" << key_entries
+      << "\n";
   } else {
-    s << "splot " << data << " using " << xy << p.fill_column << " with image notitle\n";
+    s << "splot " << data << " using " << xy << p.fill_column << " with image notitle" << key_entries << "\n";
   }
   return s.str();
 }
@@ -296,22 +336,30 @@ std::string Gnuplot::histogram_body(const HistogramPlot& p) {
     << "lo = STATS_min\n"
     << "w = (STATS_max > STATS_min) ? (STATS_max - STATS_min) / nbins : 1.0\n"
     << "bin(x) = lo + w * ((floor((x - lo) / w) < nbins ? floor((x - lo) / w) : nbins - 1) + 0.5)\n"
-    << "set boxwidth w * 0.9\nset style fill solid 0.6 border -1\nset grid ytics\nunset key\nset yrange [0:*]\n"
+    << "set boxwidth w * 0.9\nset style fill solid 0.6 border lc rgb '#404040'\nset grid ytics\nunset key\nset yrange [0:*]\n"
     << "plot " << quote(p.csv_path) << " skip " << p.header_lines << " using (bin(" << col(p.column)
-    << ")):(1.0) smooth frequency with boxes\n";
+    << ")):(1.0) smooth frequency with boxes lc rgb '" << plot_style::kBlue << "'\n";
   return s.str();
 }
 
+// The bodies name the data relative to the script's folder (the script runs there).
+template <class P>
+P with_relative_data(const P& p) {
+  P q = p;
+  q.csv_path = Gnuplot::relative_to(p.csv_path, fs::path(Gnuplot::beside_csv(p, ".gp")).parent_path().string());
+  return q;
+}
+
 PlotStatus Gnuplot::xy_lines(const XYLinesPlot& p) const {
-  return run(xy_lines_body(p), beside_csv(p, ".gp"), p.png_path, p.width_px, p.height_px);
+  return run(xy_lines_body(with_relative_data(p)), beside_csv(p, ".gp"), p.png_path, p.width_px, p.height_px);
 }
 
 PlotStatus Gnuplot::scatter(const ScatterPlot& p) const {
-  return run(scatter_body(p), beside_csv(p, ".gp"), p.png_path, p.width_px, p.height_px);
+  return run(scatter_body(with_relative_data(p)), beside_csv(p, ".gp"), p.png_path, p.width_px, p.height_px);
 }
 
 PlotStatus Gnuplot::histogram(const HistogramPlot& p) const {
-  return run(histogram_body(p), beside_csv(p, ".gp"), p.png_path, p.width_px, p.height_px);
+  return run(histogram_body(with_relative_data(p)), beside_csv(p, ".gp"), p.png_path, p.width_px, p.height_px);
 }
 
 PlotStatus Gnuplot::grid(const GridPlot& p) const {
@@ -347,7 +395,9 @@ PlotStatus Gnuplot::grid(const GridPlot& p) const {
       out << "\n";
     }
   }
-  return run(grid_body(p, dat), beside_csv(p, ".gp"), p.png_path, p.width_px, p.height_px);
+  const std::string script = beside_csv(p, ".gp");
+  return run(grid_body(with_relative_data(p), relative_to(dat, fs::path(script).parent_path().string())), script,
+             p.png_path, p.width_px, p.height_px);
 }
 
 }  // namespace abuopt

@@ -1,5 +1,7 @@
 #include "abuopt/common/yaml_reader.hpp"
 
+#include "abuopt/common/suggest.hpp"
+
 #include <cerrno>
 #include <cmath>
 #include <filesystem>
@@ -291,7 +293,10 @@ void YamlReader::finish() const {
     // YAML's own exception (an internal error instead of a config error).
     const std::string k = it->first.IsScalar() ? it->first.Scalar() : yaml_value_text(it->first);
     if (!read_.count(k)) {
-      throw ConfigError(key_path(k), yaml_value_text(it->second), "unknown key (misspelt, or not valid here)");
+      // Every key asked for here (present or not) is a known key: the nearest one is the hint.
+      const std::vector<std::string> known(read_.begin(), read_.end());
+      throw ConfigError(key_path(k), yaml_value_text(it->second),
+                        "unknown key (misspelt, or not valid here)" + did_you_mean(k, known));
     }
   }
 }

@@ -16,6 +16,7 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/gnuplot.hpp"
+#include "abuopt/common/plot_style.hpp"
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/text.hpp"
 #include "abuopt/optimizer/algorithms.hpp"
@@ -491,47 +492,66 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
   }
 
   {
-    // Every text from the setup (solver and problem labels) goes through Gnuplot::quote: a label
-    // cannot end the string and add a command.
+    // Every text from the setup (solver and problem labels) goes through Gnuplot::quote (with
+    // noenhanced: shown literally, see plot_style.hpp): a label cannot end the string and add a
+    // command. Each figure is drawn as PNG, then replotted as PDF (plot_style.hpp).
     OutFile f(dir / "plots.gp", written);
     const std::size_t ns = r.solvers.size();
-    f << "# gnuplot script written by abuopt compare; run: gnuplot plots.gp (in this directory)\n"
-      << "set datafile separator ','\nset terminal pngcairo size 900,600 noenhanced\nset key bottom right\n"
-      << "set grid\nset yrange [0:1.05]\n";
-    f << "set output 'data_profile.png'\nset title 'Data profile (tau = " << format_number(r.tau)
-      << "): fraction of problems solved within alpha (n_p+1) evaluations'\n"
-      << "set xlabel 'alpha = evaluations / (n_p + 1)'\nset ylabel 'd_s(alpha)'\nplot ";
+    const Gnuplot probe;
+    const std::string png_terminal = make_plots && probe.available() ? probe.terminal() : std::string("pngcairo");
+    const int w = 900, h = 600;
+    auto begin_figure = [&](const std::string& png) {
+      f << plot_style::png_terminal_line(png_terminal, w, h) << "set output " << Gnuplot::quote(png) << "\n";
+    };
+    auto end_figure = [&](const std::string& png) {
+      f << plot_style::pdf_terminal_line(w, h) << "set output "
+        << Gnuplot::quote(fs::path(png).replace_extension(".pdf").string()) << "\nreplot\nunset output\n";
+    };
+    f << "# gnuplot script written by abuopt compare; run in this folder: gnuplot plots.gp (PNG and PDF of each figure)\n";
+    begin_figure("data_profile.png");
+    f << plot_style::preamble() << "set datafile separator ','\nset key bottom right\nset grid\nset yrange [0:1.05]\n";
+    f << "set title 'Data profile (τ = " << format_number(r.tau)
+      << "): fraction of problems solved within α (n_p + 1) evaluations'\n"
+      << "set xlabel 'α = evaluations / (n_p + 1)'\nset ylabel 'd_s(α)'\nplot ";
     for (std::size_t s = 0; s < ns; ++s)
-      f << (s ? ", " : "") << "'data_profile.csv' using 1:" << s + 2 << " with steps lw 2 title "
-        << Gnuplot::quote(r.solvers[s]);
-    f << "\nset output 'performance_profile.png'\nset title 'Performance profile (tau = " << format_number(r.tau)
+      f << (s ? ", " : "") << "'data_profile.csv' using 1:" << s + 2 << " with steps lt " << s + 1 << " title "
+        << plot_style::literal(r.solvers[s]);
+    f << "\n";
+    end_figure("data_profile.png");
+    begin_figure("performance_profile.png");
+    f << "set title 'Performance profile (τ = " << format_number(r.tau)
       << "): evaluations relative to the best solver'\nset logscale x 2\n"
-      << "set xlabel 'ratio to the best solver'\nset ylabel 'rho_s(ratio)'\nplot ";
+      << "set xlabel 'ratio r to the best solver'\nset ylabel 'ρ_s(r)'\nplot ";
     for (std::size_t s = 0; s < ns; ++s)
-      f << (s ? ", " : "") << "'performance_profile.csv' using 1:" << s + 2 << " with steps lw 2 title "
-        << Gnuplot::quote(r.solvers[s]);
-    f << "\nunset logscale x\nset datafile separator whitespace\nset autoscale y\nset logscale y\nset key top right\n"
-      << "set format y '%.0e'\n";
+      f << (s ? ", " : "") << "'performance_profile.csv' using 1:" << s + 2 << " with steps lt " << s + 1 << " title "
+        << plot_style::literal(r.solvers[s]);
+    f << "\n";
+    end_figure("performance_profile.png");
+    f << "unset logscale x\nset datafile separator whitespace\nset autoscale y\nset logscale y\nset key top right\n"
+      << "set format y '10^{%L}'\n";
     for (std::size_t p = 0; p < r.problems.size(); ++p) {
-      f << "set output " << Gnuplot::quote(pngs[2 + p]) << "\nset title "
-        << Gnuplot::quote("Convergence on " + r.problems[p] + " (first start): best feasible (f - f*) / max(|f*|, 1)")
+      begin_figure(pngs[2 + p]);
+      f << "set title " << plot_style::typeset("Convergence on " + plot_style::escape(r.problems[p]) +
+                                               " (first start): best feasible (f - f^*) / max(|f^*|, 1)")
         << "\nset xlabel 'evaluations'\n"
-        << "set ylabel 'relative gap'\nplot ";
+        << "set ylabel 'relative gap to f^*'\nplot ";
       for (std::size_t s = 0; s < curves[p].size(); ++s) {
         const Curve& c = curves[p][s];
         f << (s ? ", " : "");
         const std::string title =
             c.solver + (c.reached_at < 0 ? "" : " (reaches f* at evaluation " + std::to_string(c.reached_at) + ")");
+        // The solver's colour is its column in the setup, whether or not it has a curve.
         if (c.index < 0) {  // nothing to draw: no feasible point, or a gap of 0 from the first one
-          f << "NaN with lines lw 2 title " << Gnuplot::quote(c.reached_at < 0 ? c.solver + " (no feasible point)" : title);
+          f << "NaN with lines lt " << s + 1 << " title "
+            << plot_style::literal(c.reached_at < 0 ? c.solver + " (no feasible point)" : title);
           continue;
         }
-        f << Gnuplot::quote(conv_files[p]) << " index " << c.index << " using 1:2 with lines lw 2 title "
-          << Gnuplot::quote(title);
+        f << Gnuplot::quote(conv_files[p]) << " index " << c.index << " using 1:2 with lines lt " << s + 1 << " title "
+          << plot_style::literal(title);
       }
       f << "\n";
+      end_figure(pngs[2 + p]);
     }
-    f << "unset output\n";
     f.commit();
   }
 
@@ -542,12 +562,21 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
   } else {
     // No shell: gnuplot runs with an argument vector, in the output directory.
     std::error_code ec;
-    for (const std::string& png : pngs) fs::remove(dir / png, ec);
+    auto pdf_of = [](const std::string& png) { return fs::path(png).replace_extension(".pdf").string(); };
+    for (const std::string& png : pngs) {
+      fs::remove(dir / png, ec);
+      fs::remove(dir / pdf_of(png), ec);
+    }
     const fs::path abs = fs::absolute(dir);
     const int rc = gp.run_script("plots.gp", abs.string(), (abs / "gnuplot.log").string());
+    auto made = [&](const std::string& file) { return fs::exists(dir / file, ec) && fs::file_size(dir / file, ec) > 0; };
     for (const std::string& png : pngs) {
-      if (rc == 0 && fs::exists(dir / png) && fs::file_size(dir / png) > 0) written.files.push_back((dir / png).string());
-      else written.skipped_plots.push_back(png);
+      if (rc == 0 && made(png) && made(pdf_of(png))) {
+        written.files.push_back((dir / png).string());
+        written.files.push_back((dir / pdf_of(png)).string());
+      } else {
+        written.skipped_plots.push_back(png);
+      }
     }
   }
   return written;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "abuopt/common/plot_style.hpp"
 #include "abuopt/core/equilibrium_set.hpp"
 #include "output_dir.hpp"
 #include "study_text.hpp"
@@ -27,6 +28,18 @@ PlotNote finish_note(PlotNote n, const PlotStatus& st) {
   return n;
 }
 
+// The studied parameter as a typeset axis label: the report's symbols where known.
+std::string parameter_label(const ReproductionTable& t) {
+  const std::string& n = t.parameter_name;
+  const std::string unit = t.parameter_unit.empty() ? "" : " [" + plot_style::escape(t.parameter_unit) + "]";
+  if (n == "mu") return plot_style::kMu;
+  if (n == "dt") return "Δt" + unit;
+  if (n == "dt2") return "Δt_2" + unit;
+  if (n == "dt3") return "Δt_3" + unit;
+  if (n == "total") return "total startup time" + unit;
+  return plot_style::escape(n) + unit;
+}
+
 }  // namespace
 
 PlotNote plot_trend(const Gnuplot& gp, const TableResult& t, const PlotRequest& req, const fs::path& dir) {
@@ -34,35 +47,40 @@ PlotNote plot_trend(const Gnuplot& gp, const TableResult& t, const PlotRequest& 
   note.name = req.name;
   note.csv = (dir / (req.name + ".csv")).string();
   std::ostringstream csv;
-  csv << "value,mean_x_1e7,pct_mi_x,pct_mi_x_ci_lo,pct_mi_x_ci_hi,ref_mean_1e7,ref_pct_mi,mean_mag_1e7,pct_mi_mag\n";
-  std::size_t points = 0;
+  csv << "value,mean_x_1e7,pct_mi_x,pct_mi_x_ci_lo,pct_mi_x_ci_hi,ref_mean_1e7,ref_pct_mi,mean_mag_1e7,pct_mi_mag,"
+         "mean_x_ci_lo_1e7,mean_x_ci_hi_1e7\n";
+  std::size_t points = 0, reference_points = 0;
   for (const CaseSummary& s : t.rows) {
     if (!s.value || s.ok == 0) continue;
     ++points;
+    if (s.reference.mean_1e7 || s.reference.pct_mi) ++reference_points;
+    // 95 % interval of the mean: mean +- 1.96 standard errors (the tables' "+-").
     csv << csv_num(*s.value) << ',' << csv_num(s.mean_x) << ',' << csv_num(s.pct_mi_x) << ',' << csv_num(s.ci_x[0])
         << ',' << csv_num(s.ci_x[1]) << ',' << csv_opt(s.reference.mean_1e7) << ',' << csv_opt(s.reference.pct_mi)
-        << ',' << csv_num(s.mean_mag) << ',' << csv_num(s.pct_mi_mag) << '\n';
+        << ',' << csv_num(s.mean_mag) << ',' << csv_num(s.pct_mi_mag) << ',' << csv_num(s.mean_x - 1.96 * s.sem_x)
+        << ',' << csv_num(s.mean_x + 1.96 * s.sem_x) << '\n';
   }
   write_text_file(note.csv, csv.str());
   if (points == 0) {
     note.message = "skipped: no case with a value";
     return note;
   }
-  const std::string data = Gnuplot::quote(note.csv);
-  const std::string xl = t.table.parameter_name + (t.table.parameter_unit.empty() ? "" : " [" + t.table.parameter_unit + "]");
+  const std::string data = Gnuplot::quote(req.name + ".csv");
   std::ostringstream b;
   b << "set datafile separator ','\n"
     << "set datafile missing ''\n"
-    << "set title " << Gnuplot::quote(table_heading(t.table) + ": ours (I_r,x) and the report") << "\n"
-    << "set xlabel " << Gnuplot::quote(xl) << "\n"
-    << "set ylabel 'mean I_r,x [1e-7 kg m]'\n"
-    << "set y2label '%MI [%]'\n"
-    << "set ytics nomirror\nset y2tics\nset grid\nset key outside below\nset offsets graph 0.03, graph 0.03, 0, 0\n"
-    << "plot " << data << " skip 1 using 1:2 with linespoints pt 7 lc rgb '#1f77b4' title 'mean I_r,x (ours)', \\\n"
-    << "     " << data << " skip 1 using 1:6 with points pt 6 ps 1.5 lc rgb '#1f77b4' title 'mean (report)', \\\n"
-    << "     " << data
-    << " skip 1 using 1:3:4:5 axes x1y2 with yerrorlines pt 5 lc rgb '#d62728' title '%MI (ours, 95 % CI)', \\\n"
-    << "     " << data << " skip 1 using 1:7 axes x1y2 with points pt 4 ps 1.5 lc rgb '#d62728' title '%MI (report)'\n";
+    << "set title " << plot_style::literal(table_heading(t.table)) << "\n"
+    << "set xlabel " << plot_style::typeset(parameter_label(t.table)) << "\n"
+    << "set ylabel 'mean " << plot_style::kIrx << "'\n"
+    << "set y2label '" << plot_style::kPctMi << "'\n"
+    << "set ytics nomirror\nset y2tics\nset yrange [0:*]\nset y2range [0:*]\nset grid\nset key outside below\n"
+    << "set offsets graph 0.03, graph 0.03, 0, 0\n"
+    << "plot " << data << " skip 1 using 1:2:10:11 with yerrorlines lt 1 pt 7 title 'mean I_{r,x}, 95 % interval', \\\n"
+    << "     " << data << " skip 1 using 1:3:4:5 axes x1y2 with yerrorlines lt 4 pt 5 title '%MI, 95 % Wilson interval'";
+  if (reference_points > 0)
+    b << ", \\\n     " << data << " skip 1 using 1:6 with points lt 1 pt 6 ps 1.8 title 'mean (2003 report)', \\\n"
+      << "     " << data << " skip 1 using 1:7 axes x1y2 with points lt 4 pt 4 ps 1.8 title '%MI (2003 report)'";
+  b << "\n";
   const std::string png = (dir / (req.name + ".png")).string();
   return finish_note(note, gp.run(b.str(), (dir / (req.name + ".gp")).string(), png, 900, 650));
 }
@@ -101,8 +119,10 @@ PlotNote plot_final_positions(const Gnuplot& gp, const TableResult& t, const Plo
   p.csv_path = note.csv;
   p.png_path = (dir / (req.name + ".png")).string();
   p.width_px = 800;
-  p.height_px = 800;
-  p.labels = {"Final ball positions (cf. report fig 4.7)", "beta_1 [rad]", "beta_2 [rad]"};
+  p.labels = {"Final ball positions (cf. report fig. 4.7)", plot_style::kBeta1, plot_style::kBeta2};
+  p.angle_x = p.angle_y = true;
+  p.key = "outside below";
+  p.height_px = 860;
   for (std::size_t k = 0; k < res.size(); ++k)
     p.series.push_back({static_cast<int>(2 * k + 1), static_cast<int>(2 * k + 2), labels[k], "points"});
   return finish_note(note, gp.xy_lines(p));
@@ -130,9 +150,9 @@ PlotNote plot_settling(const Gnuplot& gp, const TableResult& t, const PlotReques
   HistogramPlot p;
   p.csv_path = note.csv;
   p.png_path = (dir / (req.name + ".png")).string();
-  p.labels = {"Settling time, " + t.table.find_case(req.case_ids.front())->label + " (" + std::to_string(n) +
-                  " settled runs)",
-              "settling time [s]", "runs"};
+  p.labels = {"Settling time, " + plot_style::escape(t.table.find_case(req.case_ids.front())->label) + " (" +
+                  std::to_string(n) + " settled runs)",
+              "settling time [s]", "runs per bin"};
   p.bins = 40;
   return finish_note(note, gp.histogram(p));
 }
@@ -176,31 +196,33 @@ PlotNote plot_equilibrium(const Gnuplot& gp, const TableResult& t, const PlotReq
   // Frictionless balancing positions: beta = +- arccos(-m_I e / (2 m L)).
   const AbuParameters& a = c->study.setup.abu;
   const double ratio = a.imbalance_kgm() / (2.0 * a.balls[0].mass_kg * a.ball_track_radius_m);
+  const std::string grid_data = Gnuplot::quote(req.name + ".grid.csv");
+  const std::string final_data = Gnuplot::quote(req.name + ".csv");
   std::ostringstream b;
   b << "set datafile separator ','\n"
-    << "set title " << Gnuplot::quote("Final positions over the equilibrium set at " + num(f, 1) + " Hz (mu = " +
-                                      short_num(a.friction_mu) + "; coverage " + num(100.0 * g.coverage(), 1) + " %)")
-    << "\n"
-    << "set xlabel 'beta_1 [rad]'\nset ylabel 'beta_2 [rad]'\nset size square\n"
-    << "set xrange [0:2*pi]\nset yrange [0:2*pi]\n"
-    << "set palette defined (0 '#ffffff', 1 '#c6dbef', 2 '#6baed6', 3 '#2171b5')\n"
-    << "set cblabel 'steady amplitude with the balls stuck there [mm]'\n"
+    << "set title 'Final positions and the equilibrium set at " << num(f, 1) << " Hz (μ = " << short_num(a.friction_mu)
+    << ", set covers " << num(100.0 * g.coverage(), 1) << " % of the square)'\n"
+    << "set xlabel '" << plot_style::kBeta1 << "'\nset ylabel '" << plot_style::kBeta2 << "'\nset size square\n"
+    << plot_style::angle_axis("x") << plot_style::angle_axis("y")
+    << "set palette defined (0 '" << plot_style::kOutOfSet << "', 1 '" << plot_style::kInSet << "')\n"
+    << "set cbrange [0:1]\nunset colorbox\nset grid front\n"
     << "set key outside below\n";
   if (ratio < 1.0) {
     const double bb = std::acos(-ratio);
-    b << "set label 1 '' at " << bb << "," << 2 * M_PI - bb << " point pt 3 ps 3 lw 2 lc rgb '#d62728' front\n"
-      << "set label 2 '' at " << 2 * M_PI - bb << "," << bb << " point pt 3 ps 3 lw 2 lc rgb '#d62728' front\n";
+    b << "$balancing << EOD\n" << csv_num(bb) << "," << csv_num(2 * M_PI - bb) << "\n"
+      << csv_num(2 * M_PI - bb) << "," << csv_num(bb) << "\nEOD\n";
   }
-  b << "plot " << Gnuplot::quote(grid_csv)
-    << " skip 1 using 1:2:4 with image title 'steady amplitude (background)', \\\n"
-    << "     " << Gnuplot::quote(grid_csv)
-    << " skip 1 using 1:(column(3) < 0.5 ? column(2) : NaN) with points pt 1 ps 0.4 lc rgb '#888888' "
-       "title 'outside the equilibrium set', \\\n"
-    << "     " << Gnuplot::quote(note.csv)
-    << " skip 1 using 1:2 with points pt 7 ps 0.6 lc rgb '#000000' title 'final positions (red stars: frictionless "
-       "balancing positions)'\n";
+  b << "plot " << grid_data << " skip 1 using 1:2:3 with image notitle, \\\n"
+    << "     NaN with boxes fs solid 1.0 lc rgb '" << plot_style::kInSet << "' title 'in the equilibrium set', \\\n"
+    << "     NaN with boxes fs solid 1.0 border lc rgb '#bbbbbb' lc rgb '" << plot_style::kOutOfSet
+    << "' title 'outside it', \\\n"
+    << "     " << final_data << " skip 1 using 1:2 with points pt 7 ps 0.5 lc rgb '#000000' title 'final positions'";
+  if (ratio < 1.0)
+    b << ", \\\n     $balancing using 1:2 with points pt 3 ps 3 lw 2 lc rgb '" << plot_style::kRed
+      << "' title 'frictionless balancing positions'";
+  b << "\n";
   const std::string png = (dir / (req.name + ".png")).string();
-  return finish_note(note, gp.run(b.str(), (dir / (req.name + ".gp")).string(), png, 820, 860));
+  return finish_note(note, gp.run(b.str(), (dir / (req.name + ".gp")).string(), png, 820, 900));
 }
 
 }  // namespace abuopt::studies_detail

@@ -1,5 +1,7 @@
 #include "abuopt/studies/reproduction_report.hpp"
 
+#include "abuopt/studies/terms.hpp"
+
 #include <algorithm>
 #include <cstdio>
 #include <ctime>
@@ -225,9 +227,10 @@ std::string format_report_markdown(const ReproductionReport& r, const Reproducti
      << "- wall time: " << num(r.wall_time_s, 1) << " s on " << r.concurrency << " thread"
      << (r.concurrency == 1 ? "" : "s") << "\n";
   if (!opt.runs_note.empty()) os << "- " << opt.runs_note << "\n";
-  os << "- I_r,x is the report's definition (eq 4.2), in 1e-7 kg m; %MI is the share of runs with I_r,x >= m_I e "
-        "= 2.072e-6 kg m, with our 95 % Wilson score interval; \"in CI\" says whether the report's %MI lies inside it.\n"
-     << "- |I_r| (the magnitude of the residual imbalance vector) is not in the report: extra columns.\n\n";
+  os << "- the tables show I_r,x (the report's definition) in 1e-7 kg m; %MI with I_r,x >= m_I e = 2.072e-6 kg m, "
+        "with our 95 % Wilson score interval; \"in CI\" says whether the report's %MI lies inside it.\n"
+     << "- |I_r| (the magnitude of the residual imbalance vector) is not in the report: extra columns.\n\n"
+     << terms_markdown();
   const std::vector<Verdict> verdicts = r.verdicts();
   os << "## Verdicts on the report's conclusions\n\n";
   if (verdicts.empty()) os << "(no conclusion was tested: the tables that carry them were not run)\n";
@@ -242,7 +245,10 @@ std::string format_report_markdown(const ReproductionReport& r, const Reproducti
   for (const PlotNote& p : r.plots) {
     if (p.made)
       os << "- " << p.name << ": ![" << p.name << "](" << fs::path(p.png).lexically_relative(opt.out_dir).string()
-         << ") (data: `" << fs::path(p.csv).lexically_relative(opt.out_dir).string() << "`)\n";
+         << ") (PDF: `" << fs::path(p.png).replace_extension(".pdf").lexically_relative(opt.out_dir).string()
+         << "`; data: `" << fs::path(p.csv).lexically_relative(opt.out_dir).string() << "`; script: `"
+         << fs::path(p.png).replace_extension(".gp").lexically_relative(opt.out_dir).string()
+         << "`, run in its folder)\n";
     else
       os << "- " << p.name << ": " << p.message << "\n";
   }

@@ -40,8 +40,20 @@ ReproductionReport run_reproduction(const std::vector<ReproductionTable>& tables
 
   ThreadPoolRunner runner(opt.threads);
   report.concurrency = runner.concurrency();
-  std::size_t total_cases = 0, done_cases = 0;
-  for (const ReproductionTable& t : tables) total_cases += t.cases.size();
+  std::size_t total_cases = 0, done_cases = 0, total_runs = 0, runs_before = 0;
+  for (const ReproductionTable& t : tables) {
+    total_cases += t.cases.size();
+    for (const ReproductionCase& c : t.cases) total_runs += c.study.runs * (t.contact_variant ? 2 : 1);
+  }
+  // Progress of one Monte Carlo, counted from the runs of the cases before it.
+  auto run_case = [&](const MonteCarloStudy& study) {
+    ProgressCallback cb;
+    if (opt.progress)
+      cb = [&opt, &runs_before, total_runs](std::size_t done, std::size_t, double) { opt.progress(runs_before + done, total_runs); };
+    MonteCarloResult r = run_monte_carlo(study, runner, cb);
+    runs_before += study.runs;
+    return r;
+  };
   const auto t_start = clock::now();
 
   for (const ReproductionTable& table : tables) {
@@ -53,7 +65,7 @@ ReproductionReport run_reproduction(const std::vector<ReproductionTable>& tables
     if (ec) throw OutputError("cannot create " + run_dir.string() + " (" + ec.message() + ")");
     for (std::size_t k = 0; k < table.cases.size(); ++k) {
       const ReproductionCase& c = table.cases[k];
-      MonteCarloResult result = run_monte_carlo(c.study, runner);
+      MonteCarloResult result = run_case(c.study);
       const fs::path csv_path = run_dir / (c.id + ".csv");
       {
         std::ostringstream f;
@@ -76,7 +88,7 @@ ReproductionReport run_reproduction(const std::vector<ReproductionTable>& tables
       if (table.contact_variant) {
         MonteCarloStudy cs = c.study;
         cs.setup.abu.ball_contact = *table.contact_variant;
-        MonteCarloResult cr = run_monte_carlo(cs, runner);
+        MonteCarloResult cr = run_case(cs);
         {
           std::ostringstream f;
           write_runs_csv(f, cr.samples);

@@ -25,9 +25,10 @@ inline std::string mi_text(const CaseSummary& s) {
 }
 inline std::string mean_text(const CaseSummary& s) { return num(s.mean_x, 2) + " +- " + num(kZ95 * s.sem_x, 2); }
 
-// CSV numbers of the reproduction's files: 10 significant digits (common/text.hpp).
-inline std::string csv_num(double v) { return csv_number(v, 10); }
-inline std::string csv_opt(const std::optional<double>& v) { return csv_optional(v, 10); }
+// CSV numbers of the reproduction's files: shortest text that reads back to the same double
+// (common/text.hpp); an absent value is an empty field.
+inline std::string csv_num(double v) { return csv_number(v); }
+inline std::string csv_opt(const std::optional<double>& v) { return v ? csv_number(*v) : std::string(); }
 
 inline std::string table_heading(const ReproductionTable& t) {
   const std::string name = (t.id == "final" || t.id == "mu") ? t.title : "Table " + t.id + ": " + t.title;

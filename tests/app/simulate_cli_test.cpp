@@ -55,7 +55,7 @@ TEST(SimulateCli, BadInputGivesOneClearMessageAndStatus2) {
     std::string yaml, extra, message;
   };
   const Case cases[] = {
-      {"abu: {frition_mu: 0.02}\n", "", "abu.frition_mu = 0.02: unknown key (misspelt, or not valid here)"},
+      {"abu: {frition_mu: 0.02}\n", "", "abu.frition_mu = 0.02: unknown key (misspelt, or not valid here); did you mean 'friction_mu'?"},
       {"abu: {friction_mu: lots}\n", "", "abu.friction_mu = lots: must be a number"},
       {"abu: {friction_mu: 1.5}\n", "", "abu.friction_mu = 1.5: must be in [0, 0.999]"},
       {"profile: {segments: [{end_frequency_hz: 25, duration_s: -2}]}\n", "",

@@ -119,7 +119,7 @@ TEST(ConfigFields, ReadsEveryKind) {
 
 TEST(ConfigFields, ErrorsNameKeyValueAndRule) {
   EXPECT_EQ(error_of([] { read("rtol: 0.5"); }), "rtol = 0.5: must be in [1e-14, 0.1]");
-  EXPECT_EQ(error_of([] { read("rtoll: 0.5"); }), "rtoll = 0.5: unknown key (misspelt, or not valid here)");
+  EXPECT_EQ(error_of([] { read("rtoll: 0.5"); }), "rtoll = 0.5: unknown key (misspelt, or not valid here); did you mean 'rtol'?");
   EXPECT_EQ(error_of([] { read("runs: 1.5"); }), "runs = 1.5: must be a whole number");
   EXPECT_EQ(error_of([] { read("shape: oval"); }), "shape = oval: must be one of: round, square");
   EXPECT_EQ(error_of([] { read("items: [{count: 1}]"); }), "items[0].mass_kg = <missing>: is required");

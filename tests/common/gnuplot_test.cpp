@@ -57,6 +57,13 @@ bool is_png(const fs::path& p) {
   return f && sig[1] == 'P' && sig[2] == 'N' && sig[3] == 'G' && fs::file_size(p) > 100;
 }
 
+bool is_pdf(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  char sig[5] = {};
+  f.read(sig, 5);
+  return f && std::string(sig, 5) == "%PDF-" && fs::file_size(p) > 100;
+}
+
 }  // namespace
 
 TEST(Gnuplot, QuotesStringsForGnuplot) {
@@ -92,9 +99,12 @@ TEST(Gnuplot, MissingExecutableIsSkippedButScriptIsWritten) {
   ASSERT_TRUE(fs::exists(s.script_path));
   EXPECT_EQ(s.script_path, (d / "lines.gp").string());
   const std::string script = slurp(s.script_path);
-  EXPECT_NE(script.find("set output '" + p.png_path + "'"), std::string::npos) << script;
-  EXPECT_NE(script.find("skip 1 using 1:2 with lines"), std::string::npos) << script;
-  EXPECT_NE(script.find("skip 1 using 1:3 with points"), std::string::npos) << script;
+  // Outputs and data relative to the script's folder; PNG, then the same figure as PDF.
+  EXPECT_NE(script.find("set output 'lines.png'"), std::string::npos) << script;
+  EXPECT_NE(script.find("set output 'lines.pdf'\nreplot\nunset output"), std::string::npos) << script;
+  EXPECT_EQ(script.find(d.string()), std::string::npos) << "an absolute path in the script:\n" << script;
+  EXPECT_NE(script.find("'lines.csv' skip 1 using 1:2 with lines lt 1 title 'sin' noenhanced"), std::string::npos) << script;
+  EXPECT_NE(script.find("'lines.csv' skip 1 using 1:3 with points lt 2"), std::string::npos) << script;
   EXPECT_NE(script.find("set title 'it''s sin'"), std::string::npos) << script;
   EXPECT_FALSE(fs::exists(p.png_path));
   // A name that is not on PATH is missing too.
@@ -144,6 +154,7 @@ TEST(Gnuplot, MakesPngsWhenGnuplotExists) {
     EXPECT_EQ(s.message, "ok");
     EXPECT_TRUE(fs::exists(s.script_path));
     EXPECT_TRUE(is_png(s.png_path)) << s.png_path;
+    EXPECT_TRUE(is_pdf(s.pdf_path)) << s.pdf_path;
   }
   // The grid copy has the 12 scans separated by 11 blank lines, 144 data rows.
   const std::string dat = slurp(d / "grid.grid.dat");
@@ -163,4 +174,44 @@ TEST(Gnuplot, ReportsGnuplotErrors) {
   const PlotStatus s = gp.run("plot no_such_function_abc(x)\n", (d / "bad.gp").string(), (d / "bad.png").string());
   EXPECT_EQ(s.state, PlotStatus::State::Failed);
   EXPECT_NE(s.message.find("no_such_function_abc"), std::string::npos) << s.message;
+}
+
+// A script the helper wrote runs by hand from its own folder (data and outputs are relative): with
+// the outputs removed, `gnuplot NAME.gp` in that folder makes both the PNG and the PDF again, also
+// for the grid plot with its derived data file and a categorical key.
+TEST(Gnuplot, ScriptsRunFromTheirOwnFolder) {
+  const Gnuplot gp;
+  if (!gp.available()) GTEST_SKIP() << "gnuplot not installed";
+  const fs::path d = fresh_dir("own folder");
+  abuopt::XYLinesPlot xy;
+  xy.csv_path = write_lines_csv(d).string();
+  xy.png_path = (d / "xy.png").string();
+  xy.labels = {"sin", "β_1 [rad]", "I_{r,x} [10^{-7} kg m]"};
+  xy.series = {{1, 2, "sin_x", "lines"}};
+  xy.angle_x = true;
+  abuopt::GridPlot gr;
+  gr.csv_path = write_grid_csv(d, 12).string();
+  gr.png_path = (d / "grid.png").string();
+  gr.labels = {"membership", "β_1 [rad]", "β_2 [rad]"};
+  gr.angle_axes = true;
+  gr.fill_column = 3;
+  gr.categories = {{1, "#9ecae1", "in the set"}, {0, "#f2f2f2", "outside it"}};
+  for (const PlotStatus& s : {gp.xy_lines(xy), gp.grid(gr)}) {
+    ASSERT_TRUE(s.ran()) << s.message;
+    const std::string script = slurp(s.script_path);
+    EXPECT_EQ(script.find(d.string()), std::string::npos) << script;
+    EXPECT_EQ(script.find(ABUOPT_BINARY_DIR), std::string::npos) << script;
+    fs::remove(s.png_path);
+    fs::remove(s.pdf_path);
+    const int rc = gp.run_script(fs::path(s.script_path).filename().string(), d.string(), (d / "rerun.log").string());
+    EXPECT_EQ(rc, 0) << slurp(d / "rerun.log");
+    EXPECT_TRUE(is_png(s.png_path)) << s.png_path;
+    EXPECT_TRUE(is_pdf(s.pdf_path)) << s.pdf_path;
+  }
+  // The angle axis has its pi tics; the categorical key has one entry per category.
+  const std::string grid_script = slurp(d / "grid.gp");
+  EXPECT_NE(grid_script.find("'π' pi"), std::string::npos) << grid_script;
+  EXPECT_NE(grid_script.find("title 'in the set'"), std::string::npos) << grid_script;
+  EXPECT_NE(grid_script.find("title 'outside it'"), std::string::npos) << grid_script;
+  EXPECT_NE(grid_script.find("unset colorbox"), std::string::npos) << grid_script;
 }

@@ -32,7 +32,7 @@ TEST(YamlReader, UnknownKeyNamesItsPath) {
   auto r = YamlReader::load_string("sim:\n  rtol: 1e-6\n  rtoll: 2\n");
   auto s = r.child("sim");
   s.get_double("rtol");
-  EXPECT_EQ(error_of([&] { s.finish(); }), "sim.rtoll = 2: unknown key (misspelt, or not valid here)");
+  EXPECT_EQ(error_of([&] { s.finish(); }), "sim.rtoll = 2: unknown key (misspelt, or not valid here); did you mean 'rtol'?");
 }
 
 TEST(YamlReader, RuleViolationNamesKeyValueAndRule) {

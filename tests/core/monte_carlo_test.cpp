@@ -342,7 +342,7 @@ TEST(MonteCarloConfig, BadValuesNameKeyValueAndRule) {
             "montecarlo.design = montecarlo: must be one of: grid, random, lhs, halton, sobol");
   EXPECT_NE(error_of("montecarlo: {grid: 16, runs: 100}").find("montecarlo.runs = 100: must equal grid^balls"),
             std::string::npos);
-  EXPECT_EQ(error_of("montecarlo: {runz: 5}"), "montecarlo.runz = 5: unknown key (misspelt, or not valid here)");
+  EXPECT_EQ(error_of("montecarlo: {runz: 5}"), "montecarlo.runz = 5: unknown key (misspelt, or not valid here); did you mean 'runs'?");
 }
 
 }  // namespace

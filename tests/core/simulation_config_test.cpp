@@ -165,7 +165,7 @@ TEST(SimulationConfig, ReaderAndSimulatorShareOneRulePerKey) {
 
 TEST(SimulationConfig, ReadingErrorsNameKeyValueAndRule) {
   EXPECT_EQ(error_of([] { setup_from("simulation: {rtoll: 1e-6}"); }),
-            "simulation.rtoll = 1e-6: unknown key (misspelt, or not valid here)");
+            "simulation.rtoll = 1e-6: unknown key (misspelt, or not valid here); did you mean 'rtol'?");
   EXPECT_EQ(error_of([] { setup_from("simulation: {integrator: rk4}"); }),
             "simulation.integrator = rk4: must be one of: native, arkode_erk");
   EXPECT_EQ(error_of([] { setup_from("profile: {segments: [{end_frequency_hz: 10, duration_s: -2}]}"); }),

@@ -81,7 +81,7 @@ TEST(ComparisonPlots, EveryConvergenceCurveIsDrawnUnderItsOwnSolver) {
   const std::string script = read(dir / "plots.gp");
 
   // Each "index N ... title 'NAME...'" of the convergence plot: block N must be NAME's run.
-  const std::regex series("'convergence_hs071\\.dat' index ([0-9]+) using 1:2 with lines lw 2 title '([^']*)'");
+  const std::regex series("'convergence_hs071\\.dat' index ([0-9]+) using 1:2 with lines lt [0-9]+ title '([^']*)' noenhanced");
   std::map<std::string, long> index_of;
   for (auto it = std::sregex_iterator(script.begin(), script.end(), series); it != std::sregex_iterator(); ++it) {
     const std::string title = (*it)[2];
@@ -105,9 +105,10 @@ TEST(ComparisonPlots, EveryConvergenceCurveIsDrawnUnderItsOwnSolver) {
     }
   }
   // The solver without a feasible point is named, with no data; the zero gap is not drawn.
-  EXPECT_NE(script.find("NaN with lines lw 2 title 'BOBYQA (no feasible point)'"), std::string::npos) << script;
+  EXPECT_NE(script.find("NaN with lines lt 2 title 'BOBYQA (no feasible point)'"), std::string::npos) << script;
+  EXPECT_NE(script.find("title 'BOBYQA (no feasible point)' noenhanced"), std::string::npos) << script;
   EXPECT_NE(script.find("SLSQP (reaches f* at evaluation 9)"), std::string::npos) << script;
-  EXPECT_NE(script.find("NaN with lines lw 2 title 'IPOPT (reaches f* at evaluation 4)'"), std::string::npos) << script;
+  EXPECT_NE(script.find("title 'IPOPT (reaches f* at evaluation 4)' noenhanced"), std::string::npos) << script;
   for (const auto& b : data)
     for (const auto& [x, y] : b) EXPECT_GT(y, 0.0) << "a zero gap was written as " << y;
   fs::remove_all(dir);

@@ -402,7 +402,7 @@ TEST(StartupProfileProblem, ConfigErrorsNameKeyValueAndRule) {
   EXPECT_EQ(err(head + "design: {segments: [{end_frequency_hz: 30, duration_s: -1}, {duration_s: {min: 1, max: 2}}]}\n"),
             "design.segments[0].duration_s = -1: must be > 0 (a profile with a duration <= 0 is never simulated)");
   EXPECT_EQ(err(head + "design: {segments: [{end_frequency_hz: 30, duraton_s: {min: 1, max: 2}}]}\n"),
-            "design.segments[0].duraton_s = {min: 1, max: 2}: unknown key (misspelt, or not valid here)");
+            "design.segments[0].duraton_s = {min: 1, max: 2}: unknown key (misspelt, or not valid here); did you mean 'duration_s'?");
   EXPECT_EQ(err(head + "profile: {segments: [{end_frequency_hz: 25, duration_s: 1}]}\n"
                        "design: {segments: [{duration_s: {min: 1, max: 2}}, {duration_s: 3}]}\n"),
             "design.segments[1].end_frequency_hz = <missing>: is required (the profile template has no segment 1)");
@@ -420,7 +420,7 @@ TEST(StartupProfileProblem, ConfigErrorsNameKeyValueAndRule) {
             "friction values in one place)");
   EXPECT_EQ(err(head + design + "constraints: {max_pct_mi: -1}\n"), "constraints.max_pct_mi = -1: must be in [1e-09, 100]");
   EXPECT_EQ(err(head + design + "constraints: {max_startup: 20}\n"),
-            "constraints.max_startup = 20: unknown key (misspelt, or not valid here)");
+            "constraints.max_startup = 20: unknown key (misspelt, or not valid here); did you mean 'max_startup_time_s'?");
   EXPECT_EQ(err(head + design + "validation: {design: grid, grid: 4, runs: 10}\n"),
             "validation.runs = 10: must equal validation.grid^balls = 16 with the grid design");
 }

@@ -1,6 +1,7 @@
 #pragma once
-// A small gnuplot driver: writes a script beside the data CSV and runs `gnuplot script.gp` to make
-// a PNG. gnuplot is started with posix_spawn and an argument vector: no shell sees any path or
+// A small gnuplot driver: writes a script beside the data CSV and runs `gnuplot script.gp` in that
+// folder to make a PNG and a PDF (the look comes from plot_style.hpp; the script names its data
+// and outputs relative to its folder, so it can be rerun there by hand). gnuplot is started with posix_spawn and an argument vector: no shell sees any path or
 // text. A script that cannot be written throws OutputError (output_file.hpp). Plotting is optional: without gnuplot the script is still written and the status says
 // "skipped: gnuplot not found", so a study never fails for want of a plot.
 //
@@ -13,7 +14,8 @@
 //
 // Data files are CSV with `header_lines` header rows (default 1); columns are 1-based, as in
 // gnuplot's `using`. The script goes to <csv dir>/<png stem>.gp; gnuplot's output to <...>.log.
-// Text is printed literally (terminal option noenhanced): underscores are not subscripts.
+// Labels (PlotLabels, colour-box labels) are typeset (enhanced text: beta_1 shows a subscript; use
+// plot_style::escape for literal pieces); series titles are shown literally.
 #include <string>
 #include <vector>
 
@@ -29,7 +31,9 @@ struct PlotSeries {
   int x_column = 1;
   int y_column = 2;
   std::string title;
-  std::string style = "lines";  // gnuplot style: lines, points, linespoints, steps, ...
+  std::string style = "lines";  // gnuplot style: lines, points, linespoints, steps, yerrorbars, ...,
+                                // optionally with options ("points pt 6 ps 1.5")
+  int error_column = 0;         // > 0: a third `using` column (e.g. the half-width for yerrorbars)
 };
 
 // Common to every plot: where the data and the picture are.
@@ -46,6 +50,8 @@ struct XYLinesPlot : PlotFiles {
   PlotLabels labels;
   std::vector<PlotSeries> series;
   bool log_x = false, log_y = false;
+  bool angle_x = false, angle_y = false;  // axis over [0, 2 pi] with pi tics
+  std::string key = "top left";           // gnuplot `set key` position, e.g. "outside below"
 };
 
 // Points, optionally coloured by a third column (0: one colour).
@@ -55,6 +61,7 @@ struct ScatterPlot : PlotFiles {
   int color_column = 0;
   std::string color_label;
   double point_size = 0.6;
+  bool angle_axes = false;  // both axes over [0, 2 pi] with pi tics, square
 };
 
 // A regular grid in CSV rows (x changes slowest, as written by nested loops): a heat map of
@@ -72,6 +79,15 @@ struct GridPlot : PlotFiles {
   int contour_levels = 8;        // automatic levels (approximate count)
   std::string contour_title;     // key entry of the contour lines
   bool square = true;            // equal-size axes box
+  bool angle_axes = false;       // both axes over [0, 2 pi] with pi tics
+  // A categorical fill: each value of fill_column its colour and a key entry (the colour box,
+  // palette and cb_* settings above are then not used).
+  struct Category {
+    int value;
+    std::string colour;  // "#rrggbb"
+    std::string label;   // typeset
+  };
+  std::vector<Category> categories;
 };
 
 // Counts of one column in `bins` equal bins between its min and max.
@@ -87,6 +103,7 @@ struct PlotStatus {
   std::string message;      // "ok", "skipped: gnuplot not found ...", or why gnuplot failed
   std::string script_path;  // written in every state (except when the directory is unwritable)
   std::string png_path;
+  std::string pdf_path;     // the PNG's path with .pdf
   bool ran() const { return state == State::Ran; }
 };
 
@@ -105,8 +122,9 @@ class Gnuplot {
   // "pngcairo" when this gnuplot has it, else "png" (asked once, lazily).
   const std::string& terminal() const;
 
-  // Writes `script_body` (everything after the terminal/output lines) to script_path, prefixed
-  // with the terminal and output settings for png_path, and runs gnuplot on it.
+  // Writes `script_body` (everything after the terminal/output lines and the style preamble) to
+  // script_path as plot_style::figure_script (PNG, then PDF by replot) and runs gnuplot on it in the
+  // script's folder. Data paths in the body must be relative to that folder (relative_to()).
   PlotStatus run(const std::string& script_body, const std::string& script_path, const std::string& png_path,
                  int width_px = 900, int height_px = 650) const;
 
@@ -126,6 +144,8 @@ class Gnuplot {
   static std::string grid_body(const GridPlot& p, const std::string& grid_data_path);
   static std::string histogram_body(const HistogramPlot& p);
 
+  // `path` relative to the folder `dir` ("a.csv" for "out/plots/a.csv" and "out/plots").
+  static std::string relative_to(const std::string& path, const std::string& dir);
   // <csv dir>/<png stem><suffix>
   static std::string beside_csv(const PlotFiles& f, const std::string& suffix);
   // A gnuplot single-quoted string literal ('it''s'). Every text that reaches a script (labels,

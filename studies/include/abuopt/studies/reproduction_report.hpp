@@ -51,6 +51,9 @@ struct ReproductionOptions {
   std::string runs_note;         // from override_runs, for the report ("" = report's run counts)
   // One progress line per finished case (and a few more); the app prints them on stderr.
   std::function<void(const std::string& line)> log;
+  // Runs done of all cases (with the contact variants) so far, and their total; called from a
+  // worker thread (at most one at a time), so keep it cheap.
+  std::function<void(std::size_t done, std::size_t total)> progress;
 };
 
 struct ReproductionReport {
