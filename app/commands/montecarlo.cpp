@@ -16,6 +16,7 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/output_file.hpp"
+#include "abuopt/common/provenance.hpp"
 #include "abuopt/core/monte_carlo.hpp"
 #include "abuopt/core/monte_carlo_stats.hpp"
 #include "abuopt/core/simulation_config.hpp"
@@ -171,6 +172,10 @@ int run_montecarlo(const MonteCarloArgs& a) {
 
   nlohmann::json summary = to_json(stats);
   summary["study"] = study_json(a, cfg, end_time_s);
+  const Provenance prov = provenance_of(a.config);
+  summary["provenance"] = {{"abuopt_version", prov.abuopt_version},
+                           {"git_commit", prov.git_commit},
+                           {"config_hash", prov.config_hash}};
   if (!a.out.empty()) write_outputs(a.out, result, summary);
 
   if (a.json) {
