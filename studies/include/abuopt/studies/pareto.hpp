@@ -7,14 +7,16 @@
 //
 // solved by the config's optimiser (abuopt::opt::minimize) through the evaluation archive, each
 // bound a problem of its own (T's bound is part of the problem identity). The bounds are solved in
-// increasing order and each run starts from the previous bound's best point (feasible for the
-// looser bound), so the front's objective can only fall as eps grows. Each front point is then
+// increasing order; each bound is solved from the design's x0 and (warm_start) once more from the
+// previous bound's best point (feasible for the looser bound), and the better feasible run is
+// kept, so the front's objective can only fall as eps grows while a warm start alone cannot trap
+// the series in the first bound's basin (measured in docs/sweep.md). Each front point is then
 // evaluated out of sample (the validation section's fresh initial conditions), as is the report's
 // final profile, which the plot marks.
 //
 //   pareto:
 //     max_startup_time_s: [10, 12, 14, 16, 18, 20, 22]   # the eps_k, > 0, sorted here
-//     warm_start: true                                   # false: every run starts at x0
+//     warm_start: true                                   # false: only the run from x0
 #include <cstddef>
 #include <filesystem>
 #include <functional>
@@ -40,7 +42,10 @@ ParetoSettings read_pareto_settings(YamlReader section);
 struct ParetoPoint {
   double epsilon = 0;                   // the bound on T
   std::string problem_id;               // of the bounded problem (archive key)
-  opt::OptimizationResult result;       // the optimiser's run
+  opt::OptimizationResult result;       // the kept run
+  long evaluations = 0;                 // of every run of this bound
+  int starts = 1;                       // runs made (2 with a warm start)
+  bool warm_start_won = false;          // the kept run is the warm-started one
   std::vector<double> x;                // its best point (empty: none)
   double startup_time_s = 0;            // T(x)
   opt::Evaluation out_of_sample;        // x on the validation set (ok = false when not run)
