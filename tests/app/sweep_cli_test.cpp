@@ -308,3 +308,36 @@ TEST(SweepCli, BadSweepInputIsStatus2WithTheKey) {
   EXPECT_NE(missing.output.find("archive = /nonexistent/archive.sqlite: no such file"), std::string::npos)
       << missing.output;
 }
+
+TEST(SweepCli, CtrlCStopsAfterTheCurrentPointWritesThePointsSoFarAndTheRerunFinishes) {
+  const std::string cfg = write_config("sigint.yaml", std::string(kBase) +
+                                                          "sweep: {method: sobol, variables: [dt2, dt3], points: 64}\n");
+  const fs::path out = fresh_dir("sigint");
+  const fs::path log = fs::path(ABUOPT_BINARY_DIR) / "sweep_cli_test" / "sigint.log";
+  // Background job in sh: SIGINT is ignored there by default; abuopt installs its own handler.
+  const std::string script = std::string(ABUOPT_EXE) + " sweep " + cfg + " --out " + out.string() + " > " +
+                             log.string() + " 2>&1 & pid=$!; for i in $(seq 400); do grep -q 'point    2/' " +
+                             log.string() + " && break; sleep 0.05; done; kill -INT $pid; wait $pid; echo rc=$?";
+  FILE* p = popen(script.c_str(), "r");  // /bin/sh -c script
+  ASSERT_NE(p, nullptr);
+  std::string text;
+  char buf[256];
+  while (fgets(buf, sizeof buf, p)) text += buf;
+  pclose(p);
+  std::ifstream in(log);
+  const std::string output((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_NE(text.find("rc=130"), std::string::npos) << text << output;
+  EXPECT_NE(output.find("interrupted: rerun the same command"), std::string::npos) << output;
+  const Csv part = read_csv(out / "sweep.csv");
+  EXPECT_GE(part.rows.size(), 2u);
+  EXPECT_LT(part.rows.size(), 64u);
+  const nlohmann::json s = read_json(out / "summary.json");
+  EXPECT_TRUE(s["interrupted"].get<bool>());
+
+  const Result rest = run("sweep " + cfg + " --out " + out.string());
+  ASSERT_EQ(rest.status, 0) << rest.output;
+  EXPECT_NE(rest.output.find("64 of 64 points (" + std::to_string(64 - part.rows.size()) + " computed, " +
+                             std::to_string(part.rows.size()) + " from the archive"),
+            std::string::npos)
+      << rest.output;
+}
