@@ -315,8 +315,9 @@ TEST(SweepCli, CtrlCStopsAfterTheCurrentPointWritesThePointsSoFarAndTheRerunFini
   const fs::path out = fresh_dir("sigint");
   const fs::path log = fs::path(ABUOPT_BINARY_DIR) / "sweep_cli_test" / "sigint.log";
   // Background job in sh: SIGINT is ignored there by default; abuopt installs its own handler.
+  // The signal goes once the second point is reported (the wait allows 2 min for a loaded machine).
   const std::string script = std::string(ABUOPT_EXE) + " sweep " + cfg + " --out " + out.string() + " > " +
-                             log.string() + " 2>&1 & pid=$!; for i in $(seq 400); do grep -q 'point    2/' " +
+                             log.string() + " 2>&1 & pid=$!; for i in $(seq 2400); do grep -q 'point    2/' " +
                              log.string() + " && break; sleep 0.05; done; kill -INT $pid; wait $pid; echo rc=$?";
   FILE* p = popen(script.c_str(), "r");  // /bin/sh -c script
   ASSERT_NE(p, nullptr);
@@ -326,6 +327,7 @@ TEST(SweepCli, CtrlCStopsAfterTheCurrentPointWritesThePointsSoFarAndTheRerunFini
   pclose(p);
   std::ifstream in(log);
   const std::string output((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_NE(output.find("point    2/64"), std::string::npos) << "the sweep never reached its second point\n" << output;
   ASSERT_NE(text.find("rc=130"), std::string::npos) << text << output;
   EXPECT_NE(output.find("interrupted: rerun the same command"), std::string::npos) << output;
   const Csv part = read_csv(out / "sweep.csv");
