@@ -12,6 +12,7 @@
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/suggest.hpp"
 #include "abuopt/studies/terms.hpp"
+#include "abuopt/common/provenance.hpp"
 #include "commands/commands.hpp"
 
 namespace abuopt::app {
@@ -70,13 +71,16 @@ int main(int argc, char** argv) {
       "docs/security.md says what abuopt trusts, where it writes and how it runs gnuplot."};
   app.footer("\n" + abuopt::terms_text(""));
   app.require_subcommand(1);
-  app.set_version_flag("--version", "abuopt 0.1.0");
+  app.set_version_flag("--version", "abuopt " + abuopt::abuopt_version() + " (" + abuopt::abuopt_git_commit() + ")");
   abuopt::app::register_simulate(app);
   abuopt::app::register_montecarlo(app);
   abuopt::app::register_eqset(app);
   abuopt::app::register_reproduce(app);
   abuopt::app::register_compare(app);
   abuopt::app::register_optimize(app);
+  abuopt::app::register_sweep(app);
+  abuopt::app::register_pareto(app);
+  abuopt::app::register_archive(app);
 
   try {
     app.parse(argc, argv);

@@ -15,5 +15,8 @@ void register_eqset(CLI::App& app);
 void register_reproduce(CLI::App& app);
 void register_compare(CLI::App& app);
 void register_optimize(CLI::App& app);
+void register_sweep(CLI::App& app);
+void register_pareto(CLI::App& app);
+void register_archive(CLI::App& app);
 
 }  // namespace abuopt::app

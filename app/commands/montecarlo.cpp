@@ -20,6 +20,7 @@
 #include "abuopt/common/plot_style.hpp"
 #include "abuopt/common/text.hpp"
 #include "abuopt/common/progress.hpp"
+#include "abuopt/common/provenance.hpp"
 #include "abuopt/core/monte_carlo.hpp"
 #include "abuopt/core/monte_carlo_stats.hpp"
 #include "abuopt/core/simulation_config.hpp"
@@ -189,6 +190,10 @@ int run_montecarlo(const MonteCarloArgs& a) {
 
   nlohmann::json summary = to_json(stats);
   summary["study"] = study_json(a, cfg, end_time_s);
+  const Provenance prov = provenance_of(a.config);
+  summary["provenance"] = {{"abuopt_version", prov.abuopt_version},
+                           {"git_commit", prov.git_commit},
+                           {"config_hash", prov.config_hash}};
   PlotStatus plot;
   if (!a.out.empty()) {
     std::ostringstream what;

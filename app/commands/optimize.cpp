@@ -22,6 +22,7 @@
 #include "abuopt/common/plot_style.hpp"
 #include "abuopt/common/progress.hpp"
 #include "abuopt/common/output_file.hpp"
+#include "abuopt/common/provenance.hpp"
 #include "abuopt/common/text.hpp"
 #include "abuopt/core/simulation_config.hpp"
 #include "abuopt/optimizer/evaluation_archive.hpp"
@@ -61,6 +62,8 @@ LoadedConfig load_config(const OptimizeArgs& a) {
   YamlReader optimizer = root.child("optimizer");
   YamlReader sao = root.child("sao");
   c.options = opt::read_optimizer_options(optimizer, &sao);
+  root.mark_read("sweep");   // the same file may configure `abuopt sweep` and `abuopt pareto`
+  root.mark_read("pareto");
   root.finish();
   if (a.max_evaluations) {
     if (*a.max_evaluations < 1)
@@ -213,6 +216,8 @@ int run_optimize(const OptimizeArgs& a) {
   const OutputDirLock lock(out);  // creates it; one run per output directory
   const std::string id = problem.identity();
   opt::EvaluationArchive archive((out / "archive.sqlite").string(), id);
+  const Provenance prov = provenance_of(a.config);
+  archive.record_metadata("optimize", a.config, prov.config_hash);
   opt::ArchivedProblem archived(optimised, archive);
   cfg.options.sao.archive = &archive;  // SAO: archived points inform its surrogates
 
@@ -270,6 +275,9 @@ int run_optimize(const OptimizeArgs& a) {
   nlohmann::json j;
   j["config"] = a.config;
   j["problem_id"] = id;
+  j["provenance"] = {{"abuopt_version", prov.abuopt_version},
+                     {"git_commit", prov.git_commit},
+                     {"config_hash", prov.config_hash}};
   j["out"] = out.string();
   j["algorithm"] = r.algorithm;
   j["reason"] = to_string(r.reason);

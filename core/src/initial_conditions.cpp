@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <stdexcept>
 #include <numeric>
 #include <random>
 
@@ -135,6 +136,15 @@ std::vector<std::vector<double>> latin_hypercube(const InitialConditionDesign& d
 }
 
 }  // namespace
+
+std::vector<double> sobol_unit_point(std::uint64_t index, std::size_t dims) {
+  if (dims < 1 || dims > kSobolMaxDimension)
+    throw std::invalid_argument("sobol_unit_point: dims = " + std::to_string(dims) + ": must be in 1.." +
+                                std::to_string(kSobolMaxDimension));
+  std::vector<double> u(dims);
+  for (std::size_t j = 0; j < dims; ++j) u[j] = sobol_coordinate(index, sobol_directions(j));
+  return u;
+}
 
 std::uint64_t splitmix64(std::uint64_t x) {
   x += 0x9e3779b97f4a7c15ULL;

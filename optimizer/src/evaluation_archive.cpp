@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/common/provenance.hpp"
 
 namespace abuopt::opt {
 
@@ -261,6 +262,11 @@ EvaluationArchive::EvaluationArchive(const std::string& path, std::string proble
         "CREATE TABLE IF NOT EXISTS problems ("
         " problem_id TEXT PRIMARY KEY, name TEXT, variables TEXT, inequality TEXT, equality TEXT,"
         " created TEXT)");
+    exec(
+        "CREATE TABLE IF NOT EXISTS metadata ("
+        " id INTEGER PRIMARY KEY AUTOINCREMENT, problem_id TEXT NOT NULL, timestamp TEXT NOT NULL,"
+        " abuopt_version TEXT NOT NULL, git_commit TEXT NOT NULL, command TEXT NOT NULL, config TEXT NOT NULL,"
+        " config_hash TEXT NOT NULL)");
     if (!existing) exec(("PRAGMA user_version = " + std::to_string(kSchemaVersion)).c_str());
   } catch (const ConfigError&) {
     sqlite3_close(db_);
@@ -435,6 +441,52 @@ void EvaluationArchive::check_signature(const Problem& problem) {
   s.bind(5, eq);
   s.bind(6, now_utc());
   s.step();
+}
+
+void EvaluationArchive::record_metadata(const std::string& command, const std::string& config,
+                                        const std::string& config_hash) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Statement s(db_, path_,
+              "INSERT INTO metadata (problem_id, timestamp, abuopt_version, git_commit, command, config, config_hash)"
+              " VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)");
+  s.bind(1, problem_id_);
+  s.bind(2, now_utc());
+  s.bind(3, abuopt_version());
+  s.bind(4, abuopt_git_commit());
+  s.bind(5, command);
+  s.bind(6, config);
+  s.bind(7, config_hash);
+  s.step();
+}
+
+std::vector<EvaluationArchive::Metadata> EvaluationArchive::metadata() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Statement s(db_, path_,
+              "SELECT id, problem_id, timestamp, abuopt_version, git_commit, command, config, config_hash"
+              " FROM metadata WHERE problem_id = ?1 ORDER BY id");
+  s.bind(1, problem_id_);
+  std::vector<Metadata> out;
+  while (s.step())
+    out.push_back({s.integer(0), s.text(1), s.text(2), s.text(3), s.text(4), s.text(5), s.text(6), s.text(7)});
+  return out;
+}
+
+std::vector<EvaluationArchive::ProblemRecord> EvaluationArchive::problems() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Statement s(db_, path_,
+              "SELECT problem_id, name, variables, inequality, equality, created FROM problems ORDER BY rowid");
+  auto names = [](const std::string& text) {
+    std::vector<std::string> v;
+    try {
+      for (const auto& n : json::parse(text)) v.push_back(n.get<std::string>());
+    } catch (const std::exception&) {
+      throw std::runtime_error("evaluation archive: unreadable name list " + text);
+    }
+    return v;
+  };
+  std::vector<ProblemRecord> out;
+  while (s.step()) out.push_back({s.text(0), s.text(1), names(s.text(2)), names(s.text(3)), names(s.text(4)), s.text(5)});
+  return out;
 }
 
 ArchivedProblem::ArchivedProblem(Problem& inner, EvaluationArchive& archive) : inner_(inner), archive_(archive) {

@@ -461,6 +461,24 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
   m["ir_x_mean"] = all.report_x.mean / kUnit;
   m["ir_x_median"] = all.report_x.median / kUnit;
   m["ir_x_max"] = all.report_x.max / kUnit;
+  // 95 % half-widths of the two means, 1.96 s / sqrt(n) over the ok runs (the sampling error of
+  // this design's figure; docs/sweep.md), and the Wilson interval of the %MI in use.
+  auto half_width_95 = [&pooled](bool x_definition) {
+    std::vector<double> v;
+    for (const auto& smp : pooled)
+      if (smp.outcome.ok())
+        v.push_back((x_definition ? smp.outcome.residual_imbalance_x_kgm : smp.outcome.residual_imbalance_kgm) / kUnit);
+    const double n = static_cast<double>(v.size());
+    if (v.size() < 2) return std::numeric_limits<double>::quiet_NaN();
+    double mean = 0, ss = 0;
+    for (double a : v) mean += a / n;
+    for (double a : v) ss += (a - mean) * (a - mean);
+    return 1.959963984540054 * std::sqrt(ss / (n - 1) / n);
+  };
+  m["ir_magnitude_mean_hw95"] = half_width_95(false);
+  m["ir_x_mean_hw95"] = half_width_95(true);
+  m["pct_mi_ci95_lo"] = ir(all).pct_mi_ci95[0];
+  m["pct_mi_ci95_hi"] = ir(all).pct_mi_ci95[1];
   m["pct_mi_magnitude"] = all.magnitude.pct_mi;
   m["pct_mi_x"] = all.report_x.pct_mi;
   m["pct_mi"] = ir(all).pct_mi;

@@ -114,7 +114,7 @@ def main():
           f"montecarlo beta0/beta_final shapes {mc['beta0'].shape}, {mc['beta_final'].shape} == ({runs}, 2)")
     timing = {"wall_time_s"}
     summary = mc["summary"]
-    cli_summary = {k: v for k, v in cli.items() if k != "study"}
+    cli_summary = {k: v for k, v in cli.items() if k not in ("study", "provenance")}  # CLI-only: the config file's provenance
     same = {k for k in cli_summary if k not in timing and summary.get(k) == cli_summary[k]}
     differ = sorted(set(cli_summary) - timing - same)
     check(not differ and set(summary) == set(cli_summary), f"montecarlo summary == CLI --json (differ: {differ})")

@@ -160,6 +160,20 @@ TEST(StartupProfileProblem, ObjectiveKindsMatchTheEngineStatistics) {
   double sum = 0;
   for (const auto& s : run_monte_carlo(study, runner).samples) sum += s.outcome.residual_imbalance_kgm;
   EXPECT_NEAR(e.objective, sum / 4 / 1e-7, 1e-9);
+  // The 95 % half-widths of the means, 1.96 s / sqrt(n) (docs/sweep.md), by hand, and the Wilson
+  // interval of the %MI in use.
+  for (const bool xdef : {false, true}) {
+    std::vector<double> v;
+    for (const auto& s : run_monte_carlo(study, runner).samples)
+      v.push_back((xdef ? s.outcome.residual_imbalance_x_kgm : s.outcome.residual_imbalance_kgm) / 1e-7);
+    double m = 0, ss = 0;
+    for (double a : v) m += a / 4;
+    for (double a : v) ss += (a - m) * (a - m);
+    EXPECT_NEAR(e.metrics.at(xdef ? "ir_x_mean_hw95" : "ir_magnitude_mean_hw95"), 1.96 * std::sqrt(ss / 3 / 4), 1e-3 * std::sqrt(ss / 3 / 4) + 1e-12)
+        << xdef;
+  }
+  EXPECT_DOUBLE_EQ(e.metrics.at("pct_mi_ci95_lo"), st.magnitude.pct_mi_ci95[0]);
+  EXPECT_DOUBLE_EQ(e.metrics.at("pct_mi_ci95_hi"), st.magnitude.pct_mi_ci95[1]);
 
   StartupProfileProblem rx(settings_from(tiny("{kind: mean, definition: report_x}")));
   EXPECT_DOUBLE_EQ(rx.evaluate(x).objective, st.report_x.mean / 1e-7);

@@ -66,6 +66,11 @@ std::vector<std::vector<double>> generate_initial_conditions(const InitialCondit
 // O(N) for grid/random/Halton/Sobol; O(count N) for the Latin hypercube.
 std::vector<double> initial_condition_at(const InitialConditionDesign& d, std::size_t index);
 
+// Point `index` of the plain (unshifted) Sobol' sequence in [0, 1)^dims, dims <= kSobolMaxDimension
+// (std::invalid_argument otherwise): the same numbers as the Sobol design before scaling to angles.
+// Used for designs in other boxes (studies/sweep).
+std::vector<double> sobol_unit_point(std::uint64_t index, std::size_t dims);
+
 // --- Portable randomness shared by the Monte Carlo code -------------------------------------
 // splitmix64 finaliser (Steele, Lea, Flood 2014): a bijective 64-bit mixer.
 std::uint64_t splitmix64(std::uint64_t x);

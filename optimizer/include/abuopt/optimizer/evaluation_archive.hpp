@@ -24,6 +24,12 @@
 // * Run count: a value is stored with the Monte Carlo run count it was computed with (0: not a
 //   sampled problem), which is part of the key: a request at another run count never gets it.
 //
+// * Metadata (provenance): the table `metadata` holds one row per command that opened the archive
+//   for a problem (record_metadata): time, abuopt version, git commit, command, config file and
+//   the config's hash, so every evaluation can be traced (by its timestamp) to the abuopt that
+//   computed it. Added without a schema change: older archives get the table when next opened.
+// * Export: archive_export.hpp writes every stored evaluation as CSV and JSON (docs/archive.md).
+//
 // ArchivedProblem decorates any Problem: evaluate(x) first asks the archive; a hit is returned
 // with Evaluation::from_archive = true (and counted by minimize() in archive_hits), a miss is
 // evaluated by the wrapped problem and stored. Failed evaluations (ok == false) are stored too
@@ -53,6 +59,27 @@ class EvaluationArchive {
     std::string timestamp;  // ISO 8601, UTC
   };
 
+  // One row of the metadata table.
+  struct Metadata {
+    long id = 0;
+    std::string problem_id;
+    std::string timestamp;  // ISO 8601, UTC
+    std::string abuopt_version;
+    std::string git_commit;
+    std::string command;      // "optimize", "sweep", ...
+    std::string config;       // the config file as given
+    std::string config_hash;  // provenance.hpp's config_hash
+  };
+  // One row of the problems table (check_signature).
+  struct ProblemRecord {
+    std::string problem_id;
+    std::string name;
+    std::vector<std::string> variables;
+    std::vector<std::string> inequality;
+    std::vector<std::string> equality;
+    std::string created;
+  };
+
   // Opens or creates the archive file; throws abuopt::ConfigError naming the file if it cannot, if
   // SQLite finds it damaged, or if it has another schema version.
   EvaluationArchive(const std::string& path, std::string problem_id);
@@ -73,6 +100,13 @@ class EvaluationArchive {
   long count() const;
   // All intact evaluations of this problem id, in the order they were stored.
   std::vector<Entry> entries() const;
+
+  // Adds a metadata row for this problem id with this abuopt's version and git commit.
+  void record_metadata(const std::string& command, const std::string& config, const std::string& config_hash);
+  // The metadata rows of this problem id, oldest first.
+  std::vector<Metadata> metadata() const;
+  // Every problem recorded in the file (any problem id), in the order they were first recorded.
+  std::vector<ProblemRecord> problems() const;
 
   // Where warnings about damaged rows go (default: "warning: ..." on stderr).
   void set_warning_handler(std::function<void(const std::string&)> handler);

@@ -1,0 +1,182 @@
+// abuopt pareto CONFIG: the Pareto front of startup time against the objective (mean |I_r|) by the
+// epsilon-constraint method (studies/pareto.hpp): one optimisation per bound on the startup time,
+// each archived, then each front point and the report's profile out of sample. docs/sweep.md.
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "abuopt/common/config_error.hpp"
+#include "abuopt/common/output_file.hpp"
+#include "abuopt/common/provenance.hpp"
+#include "abuopt/common/text.hpp"
+#include "abuopt/optimizer/minimize.hpp"
+#include "abuopt/optimizer/optimizer_options.hpp"
+#include "abuopt/problems/startup_profile_problem.hpp"
+#include "abuopt/studies/pareto.hpp"
+#include "abuopt/studies/sweep.hpp"
+#include "commands/commands.hpp"
+
+namespace abuopt::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ParetoArgs {
+  std::string config;
+  std::string out;
+  bool json = false;
+  std::optional<long> threads;
+};
+
+nlohmann::json evaluation_json(const opt::Evaluation& e) {
+  nlohmann::json j = {{"ok", e.ok}, {"objective", e.ok ? nlohmann::json(e.objective) : nlohmann::json()},
+                      {"metrics", e.metrics}};
+  if (!e.message.empty()) j["message"] = e.message;
+  return j;
+}
+
+int run_pareto_command(const ParetoArgs& a) {
+  YamlReader root = YamlReader::load_file(a.config);
+  problems::StartupProfileSettings settings = problems::read_startup_profile_settings(root);
+  YamlReader optimizer = root.child("optimizer");
+  YamlReader sao = root.child("sao");
+  opt::OptimizerOptions options = opt::read_optimizer_options(optimizer, &sao);
+  const ParetoSettings ps = read_pareto_settings(root.child("pareto"));
+  root.mark_read("sweep");
+  root.finish();
+  options.validate();
+  if (a.threads) {
+    if (*a.threads < 0) throw ConfigError("--threads", std::to_string(*a.threads), "must be >= 0 (0 = all cores)");
+    settings.threads = static_cast<std::size_t>(*a.threads);
+  }
+  const problems::StartupProfileProblem shape(settings);  // validates; names and labels
+  const auto vars = shape.variables();
+
+  const fs::path out = a.out.empty() ? fs::path("results") / fs::path(a.config).stem() : fs::path(a.out);
+  const OutputDirLock lock(out);
+  const Provenance prov = provenance_of(a.config);
+  std::ostream& log = a.json ? std::cerr : std::cout;
+  log << "pareto " << a.config << ": " << ps.max_startup_time_s.size() << " bounds on the startup time, each solved by "
+      << options.algorithm << " (budget " << options.max_evaluations << ")" << (ps.warm_start ? ", from x0 and from the previous bound's best" : ", from x0")
+      << "; objective " << objective_label(settings) << ", " << settings.study.runs << " runs per evaluation\n"
+      << "  archive " << (out / "archive.sqlite").string() << " (a rerun resumes)\n"
+      << std::flush;
+
+  std::size_t current = static_cast<std::size_t>(-1);
+  const ParetoProgress progress = [&](std::size_t k, std::size_t n, const opt::Progress& p) {
+    if (k != current) {
+      current = k;
+      log << "bound " << k + 1 << "/" << n << ": T <= " << format_number(ps.max_startup_time_s[k]) << " s\n";
+    }
+    if (!p.last.for_gradient && (p.evaluations % 10 == 0 || p.evaluations == 1))
+      log << "  eval " << std::setw(4) << p.evaluations << "  best=" << (p.have_feasible ? format_number(p.best_objective) : "none")
+          << (p.last.from_archive ? "  [archive]" : "") << "\n" << std::flush;
+    return true;
+  };
+  const ParetoResult r = run_pareto(settings, options, ps, (out / "archive.sqlite").string(), a.config,
+                                    prov.config_hash, progress, true);
+  const std::string plot = write_pareto_outputs(out, shape, r);
+
+  log << "\n  T bound   T [s]  objective (in)   out-of-sample        %MI in/out   evals  kept run\n";
+  for (const auto& p : r.points) {
+    std::ostringstream os;
+    os << std::fixed << std::setprecision(2) << std::setw(9) << p.epsilon << std::setw(8) << p.startup_time_s
+       << std::setprecision(4) << std::setw(11) << p.result.objective << (p.result.feasible ? "  " : " *")
+       << (p.dominated ? "d" : " ");
+    if (p.out_of_sample.ok) {
+      const double hw = objective_half_width(settings, p.out_of_sample);
+      os << std::setw(10) << p.out_of_sample.objective << " +- " << std::setw(6) << hw;
+    } else {
+      os << std::setw(20) << "-";
+    }
+    auto pm = [](const opt::Evaluation& e) {
+      auto it = e.metrics.find("pct_mi");
+      return it == e.metrics.end() ? std::string("-") : format_fixed(it->second, 1);
+    };
+    os << std::setw(7) << pm(in_sample_evaluation(p)) << "/" << std::left
+       << std::setw(6) << pm(p.out_of_sample) << std::right << std::setw(6) << p.evaluations << "  "
+       << (p.warm_start_won ? "warm " : "x0 ") << to_string(p.result.reason);
+    log << os.str() << "\n";
+  }
+  log << "  (* no feasible point for this bound; d dominated by another front point; +- 95 % half-width)\n";
+  if (r.report_out_of_sample.ok)
+    log << "  2003 report profile (T = " << format_number(r.report_startup_time_s) << " s): in-sample "
+        << format_fixed(r.report_in_sample.objective, 4) << ", out-of-sample "
+        << format_fixed(r.report_out_of_sample.objective, 4) << " +- "
+        << format_fixed(objective_half_width(settings, r.report_out_of_sample), 4) << "\n";
+
+  nlohmann::json j;
+  j["config"] = a.config;
+  j["provenance"] = {{"abuopt_version", prov.abuopt_version},
+                     {"git_commit", prov.git_commit},
+                     {"config_hash", prov.config_hash}};
+  j["method"] = "epsilon_constraint";
+  j["algorithm"] = options.algorithm;
+  j["max_evaluations"] = options.max_evaluations;
+  j["warm_start"] = ps.warm_start;
+  j["objective"] = {{"kind", problems::to_string(settings.objective.kind)}, {"label", objective_label(settings)}};
+  j["montecarlo"] = {{"runs", settings.study.runs}, {"seed", settings.study.seed}};
+  j["validation"] = {{"runs", settings.validation.runs}, {"seed", settings.validation.seed}};
+  nlohmann::json pts = nlohmann::json::array();
+  for (const auto& p : r.points) {
+    nlohmann::json x = nlohmann::json::object();
+    for (std::size_t i = 0; i < vars.size() && i < p.x.size(); ++i) x[vars[i].name] = p.x[i];
+    pts.push_back({{"max_startup_time_s", p.epsilon},
+                   {"problem_id", p.problem_id},
+                   {"startup_time_s", p.startup_time_s},
+                   {"x", x},
+                   {"feasible", p.result.feasible},
+                   {"dominated", p.dominated},
+                   {"reason", to_string(p.result.reason)},
+                   {"evaluations", p.evaluations},
+                   {"starts", p.starts},
+                   {"kept_start", p.warm_start_won ? "previous_best" : "x0"},
+                   {"archive_hits", p.result.archive_hits},
+                   {"in_sample", evaluation_json(in_sample_evaluation(p))},
+                   {"out_of_sample", evaluation_json(p.out_of_sample)}});
+  }
+  j["points"] = pts;
+  j["report_profile"] = {{"startup_time_s", r.report_startup_time_s},
+                         {"in_sample", evaluation_json(r.report_in_sample)},
+                         {"out_of_sample", evaluation_json(r.report_out_of_sample)}};
+  j["interrupted"] = r.interrupted;
+  j["files"] = {{"csv", (out / "pareto.csv").string()}, {"archive", (out / "archive.sqlite").string()}};
+  j["plot"] = plot;
+  write_file_atomic(out / "summary.json", j.dump(2) + "\n");
+  log << "wrote " << (out / "pareto.csv").string() << ", " << (out / "summary.json").string() << "\n" << plot << "\n";
+  if (a.json) std::cout << j.dump(2) << "\n";
+  if (r.interrupted) return 130;
+  for (const auto& p : r.points)
+    if (p.result.feasible) return 0;
+  return 3;
+}
+
+}  // namespace
+
+void register_pareto(CLI::App& app) {
+  auto args = std::make_shared<ParetoArgs>();
+  CLI::App* sub = app.add_subcommand(
+      "pareto",
+      "Pareto front of startup time against the objective (mean |I_r|) by the epsilon-constraint method:\n"
+      "for each bound in pareto.max_startup_time_s, the config's optimiser minimises the objective with\n"
+      "startup time <= bound, from x0 and from the previous bound's best (the better is kept). Every evaluation is archived\n"
+      "in OUT/archive.sqlite (a rerun resumes). Then each front point and the 2003 report's profile on\n"
+      "fresh initial conditions (out of sample). Writes pareto.csv, summary.json, pareto.png/.pdf.\n"
+      "Exit status: 0 ok, 2 bad input, 3 no bound gave a feasible design, 4 a file could not be written,\n"
+      "130 interrupted.");
+  sub->add_option("config", args->config, "YAML config: the sections of `optimize` plus `pareto` (docs/sweep.md)")
+      ->required();
+  sub->add_option("--out", args->out, "output directory (default results/<config stem>)");
+  sub->add_flag("--json", args->json, "print summary.json to stdout (progress goes to stderr)");
+  sub->add_option("--threads", args->threads, "Monte Carlo worker threads (0 = all cores; overrides montecarlo.threads)");
+  sub->callback([args] { set_exit_code(run_pareto_command(*args)); });
+}
+
+}  // namespace abuopt::app
