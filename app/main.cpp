@@ -6,6 +6,7 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/output_file.hpp"
+#include "abuopt/parallel/parallel.hpp"
 #include "commands/commands.hpp"
 
 namespace abuopt::app {
@@ -16,7 +17,9 @@ void set_exit_code(int code) { g_exit_code = code; }
 int exit_code() { return g_exit_code; }
 }  // namespace abuopt::app
 
-int main(int argc, char** argv) {
+namespace {
+
+int run_cli(int argc, char** argv) {
   CLI::App app{
       "abuopt: simulate an Automatic Balancing Unit (ABU) during startup, evaluate startup profiles\n"
       "by Monte Carlo over initial ball positions, and optimise them.\n"
@@ -64,4 +67,14 @@ int main(int argc, char** argv) {
     return 3;
   }
   return abuopt::app::exit_code();
+}
+
+}  // namespace
+
+// Under mpirun, rank 0 runs the command and the other ranks serve its Monte Carlo studies
+// (abuopt/parallel/parallel.hpp); without mpirun this is a plain program.
+int main(int argc, char** argv) {
+  abuopt::parallel::Session mpi(argc, argv);
+  if (!mpi.is_root()) return mpi.serve();
+  return mpi.finish(run_cli(argc, argv));
 }

@@ -19,6 +19,7 @@
 #include "abuopt/core/monte_carlo.hpp"
 #include "abuopt/core/monte_carlo_stats.hpp"
 #include "abuopt/core/simulation_config.hpp"
+#include "abuopt/parallel/parallel.hpp"
 #include "commands/commands.hpp"
 
 namespace abuopt::app {
@@ -157,16 +158,13 @@ int run_montecarlo(const MonteCarloArgs& a) {
   if (!a.out.empty()) lock.emplace(a.out);
 
   const MonteCarloStudy& s = cfg.study;
-  auto sim = std::make_shared<const Simulator>(s.setup);  // validates the setup
-  const SampleFunction sample = [sim](const std::vector<double>& beta0, const RunOverrides& o) {
-    return sim->run(beta0, o);
-  };
-  const double end_time_s = sim->end_time_s();
-  ThreadPoolRunner runner(cfg.threads);
+  const double end_time_s = Simulator(s.setup).end_time_s();  // validates the setup
+  // threads per process; under mpirun the runs are spread over every rank (parallel.hpp)
+  const std::shared_ptr<BatchRunner> runner = parallel::make_runner(cfg.threads);
 
   ProgressCallback progress;
   if (isatty(fileno(stderr))) progress = ProgressBar{};
-  const MonteCarloResult result = run_monte_carlo(s, sample, runner, progress);
+  const MonteCarloResult result = run_monte_carlo(s, *runner, progress);
   const MonteCarloStats stats = compute_statistics(result);
 
   nlohmann::json summary = to_json(stats);
