@@ -1,8 +1,6 @@
 #include "codec.hpp"
 
-#include <sstream>
 
-#include "abuopt/common/config_fields.hpp"
 #include "abuopt/common/yaml_reader.hpp"
 #include "abuopt/core/simulation_config.hpp"
 
@@ -11,6 +9,10 @@ namespace abuopt::parallel::detail {
 // Every field of RunOutcome travels; a field added to it must be added here (and this size).
 static_assert(sizeof(RunOutcome) == 160 || sizeof(void*) != 8,
               "RunOutcome changed: encode the new field in put_outcome/get_outcome and update this size");
+
+// Likewise for RunOverrides.
+static_assert(sizeof(RunOverrides) == 40 || sizeof(void*) != 8,
+              "RunOverrides changed: encode the new field in put_inputs/get_inputs and update this size");
 
 void put_outcome(Writer& w, const RunOutcome& o) {
   w.put<std::int32_t>(static_cast<std::int32_t>(o.status));
@@ -50,63 +52,37 @@ RunOutcome get_outcome(Reader& r) {
   return o;
 }
 
-namespace {
-std::string indent(const std::string& text) {
-  std::istringstream in(text);
-  std::string line, out;
-  while (std::getline(in, line)) out += "  " + line + "\n";
-  return out;
+void put_inputs(Writer& w, const MonteCarloSample& s) {
+  w.put(s.beta0);
+  w.put<std::uint8_t>(s.overrides.friction_mu ? 1 : 0);
+  w.put(s.overrides.friction_mu.value_or(0.0));
+  w.put<std::uint8_t>(s.overrides.imbalance_mass_kg ? 1 : 0);
+  w.put(s.overrides.imbalance_mass_kg.value_or(0.0));
+  w.put(s.overrides.imbalance_angle_rad);
 }
 
-std::uint64_t fnv(std::uint64_t h, const void* data, std::size_t n) {
-  const auto* p = static_cast<const unsigned char*>(data);
-  for (std::size_t i = 0; i < n; ++i) {
-    h ^= p[i];
-    h *= 1099511628211ULL;
-  }
-  return h;
-}
-template <class T>
-std::uint64_t fnv(std::uint64_t h, const T& v) {
-  return fnv(h, &v, sizeof v);
-}
-}  // namespace
-
-std::string encode_study(const MonteCarloStudy& s) {
-  MonteCarloConfig c;
-  c.study = s;
-  c.threads = 0;
-  // the design's own seed is not a key (it is read from `seed`): it travels on a line of its own
-  return to_yaml(s.setup) + "montecarlo:\n" + indent(write_fields(c)) + "# design_seed " +
-         std::to_string(s.design.seed) + "\n";
+void get_inputs(Reader& r, std::vector<double>& beta0, RunOverrides& o) {
+  beta0 = r.get_doubles();
+  o = RunOverrides{};
+  const bool has_mu = r.get<std::uint8_t>() != 0;
+  const double mu = r.get<double>();
+  if (has_mu) o.friction_mu = mu;
+  const bool has_mass = r.get<std::uint8_t>() != 0;
+  const double mass = r.get<double>();
+  if (has_mass) o.imbalance_mass_kg = mass;
+  o.imbalance_angle_rad = r.get<double>();
 }
 
-MonteCarloStudy decode_study(const std::string& text) {
-  const auto at = text.rfind("# design_seed ");
-  if (at == std::string::npos) throw std::runtime_error("a study sent between ranks has no design seed");
-  YamlReader root = YamlReader::load_string(text, "<study from rank 0>");
-  SimulationSetup setup = read_simulation_setup(root);
-  MonteCarloConfig c = read_monte_carlo_config(root, std::move(setup));
+std::string encode_setup(const SimulationSetup& s) { return to_yaml(s); }
+
+SimulationSetup decode_setup(const std::string& text) {
+  YamlReader root = YamlReader::load_string(text, "<setup from rank 0>");
+  SimulationSetup s = read_simulation_setup(root);
   root.finish();
-  c.study.design.seed = std::stoull(text.substr(at + 14));
-  return c.study;
-}
-
-std::uint64_t fingerprint(const MonteCarloStudy& s, const PreparedStudy& p) {
-  std::uint64_t h = 1469598103934665603ULL;
-  const std::string text = encode_study(s);
-  h = fnv(h, text.data(), text.size());
-  for (const MonteCarloSample& smp : p.samples) {
-    h = fnv(h, smp.index);
-    h = fnv(h, smp.reused_from);
-    for (double b : smp.beta0) h = fnv(h, b);
-    h = fnv(h, smp.overrides.friction_mu.value_or(-1.0));
-    h = fnv(h, smp.overrides.imbalance_mass_kg.value_or(-1.0));
-    h = fnv(h, smp.overrides.imbalance_angle_rad);
-    h = fnv(h, smp.friction_mu);
-    h = fnv(h, smp.imbalance_kgm);
-  }
-  return h;
+  if (to_yaml(s) != text)
+    throw std::runtime_error("this rank rebuilt a different setup from rank 0's description (a field that does "
+                             "not travel, or ranks running different builds)");
+  return s;
 }
 
 }  // namespace abuopt::parallel::detail

@@ -76,11 +76,14 @@ class Reader {
 void put_outcome(Writer& w, const RunOutcome& o);
 RunOutcome get_outcome(Reader& r);
 
-// The study as text another rank rebuilds it from (setup and montecarlo section as YAML), and
-// the check that it did: a hash of the text re-encoded from the rebuilt study and of every run's
-// inputs.
-std::string encode_study(const MonteCarloStudy& s);
-MonteCarloStudy decode_study(const std::string& text);
-std::uint64_t fingerprint(const MonteCarloStudy& s, const PreparedStudy& p);
+// The inputs of one run (initial angles and uncertain parameters).
+void put_inputs(Writer& w, const MonteCarloSample& s);
+void get_inputs(Reader& r, std::vector<double>& beta0, RunOverrides& o);
+
+// The setup as text another rank rebuilds it from (YAML, read(to_yaml(s)) == s), and the rebuild,
+// checked: the rebuilt setup must write the same text (else a field does not travel, or the ranks
+// run different builds).
+std::string encode_setup(const SimulationSetup& s);
+SimulationSetup decode_setup(const std::string& text);
 
 }  // namespace abuopt::parallel::detail

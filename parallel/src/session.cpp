@@ -125,11 +125,11 @@ void injected_fault() {
     throw std::runtime_error("fault injected by ABUOPT_TEST_FAULT=" + spec);
 }
 
-// A serving rank's part of one study.
+// A serving rank's part of one study: the setup once, then chunks of run inputs until rank 0
+// says the study is over.
 void serve_job(Reader& in) {
   const auto job = in.get<std::uint64_t>();
   const auto threads = static_cast<std::size_t>(in.get<std::uint64_t>());
-  const auto expected = in.get<std::uint64_t>();
   const std::string text = in.get_string();
   auto reply = [&](std::int32_t kind, const std::function<void(Writer&)>& body) {
     Writer w;
@@ -138,22 +138,16 @@ void serve_job(Reader& in) {
     body(w);
     send(w.bytes(), 0, kTagRequest);
   };
-  PreparedStudy p;
   std::shared_ptr<const Simulator> sim;
   try {
-    const MonteCarloStudy s = detail::decode_study(text);
-    p = prepare_study(s);
-    if (detail::fingerprint(s, p) != expected)
-      throw std::runtime_error("this rank rebuilt a different study from rank 0's description (a field that does "
-                               "not travel, or ranks running different builds)");
-    sim = std::make_shared<const Simulator>(s.setup);
+    sim = std::make_shared<const Simulator>(detail::decode_setup(text));
   } catch (const std::exception& e) {
     reply(kRequestError, [&](Writer& w) { w.put(std::string(e.what())); });
-    sim.reset();
   }
   if (sim) reply(kRequestResults, [](Writer& w) { w.put<std::uint64_t>(0); });
   ThreadPoolRunner runner(threads);
   while (true) {
+    wait_for(0, kTagAssign, std::chrono::microseconds(50));  // not a spinning blocking receive
     std::vector<char> bytes = receive(0, kTagAssign);
     Reader a(bytes.data(), bytes.size());
     const auto assigned_job = a.get<std::uint64_t>();
@@ -161,13 +155,13 @@ void serve_job(Reader& in) {
     const auto count = a.get<std::uint64_t>();
     if (assigned_job != job) throw std::logic_error("rank 0 and this rank disagree on the study");
     if (count == 0) return;
+    std::vector<std::vector<double>> beta0(count);
+    std::vector<RunOverrides> overrides(count);
+    for (std::uint64_t i = 0; i < count; ++i) detail::get_inputs(a, beta0[i], overrides[i]);
     std::vector<RunOutcome> out(count);
     try {
       injected_fault();
-      runner.run(count, [&](std::size_t i) {
-        const MonteCarloSample& smp = p.samples[p.simulate[first + i]];
-        out[i] = sim->run(smp.beta0, smp.overrides);
-      });
+      runner.run(count, [&](std::size_t i) { out[i] = sim->run(beta0[i], overrides[i]); });
     } catch (const std::exception& e) {
       reply(kRequestError, [&](Writer& w) { w.put(std::string(e.what())); });
       continue;
@@ -214,8 +208,7 @@ void MpiStudyRunner::run_study(const MonteCarloStudy& s, PreparedStudy& p, const
     w.put(kCommandJob);
     w.put(job);
     w.put<std::uint64_t>(local_threads);
-    w.put(detail::fingerprint(s, p));
-    w.put(detail::encode_study(s));
+    w.put(detail::encode_setup(s.setup));
     for (int r = 1; r < ranks_; ++r) send(w.bytes(), r, kTagCommand);
   }
 
@@ -259,6 +252,9 @@ void MpiStudyRunner::run_study(const MonteCarloStudy& s, PreparedStudy& p, const
   // this thread: hands out chunks to the serving ranks and takes their outcomes
   int released = 0;  // serving ranks told that the study is over
   std::size_t reported = static_cast<std::size_t>(-1);
+  // nap between polls: 20 us after a request, doubling up to 1 ms while none comes (few wake-ups
+  // while the ranks compute, a short answer time while they are asking)
+  std::chrono::microseconds nap(20);
   try {
     while (released < ranks_ - 1) {
       int flag = 0;
@@ -271,9 +267,11 @@ void MpiStudyRunner::run_study(const MonteCarloStudy& s, PreparedStudy& p, const
           d = done;
         }
         if (progress && d != reported) progress(reported = d, total, elapsed());
-        std::this_thread::sleep_for(std::chrono::microseconds(200));
+        std::this_thread::sleep_for(nap);
+        nap = std::min(2 * nap, std::chrono::microseconds(1000));
         continue;
       }
+      nap = std::chrono::microseconds(20);
       int from = 0;
       std::vector<char> bytes = receive(st.MPI_SOURCE, kTagRequest, &from);
       Reader in(bytes.data(), bytes.size());
@@ -298,6 +296,7 @@ void MpiStudyRunner::run_study(const MonteCarloStudy& s, PreparedStudy& p, const
       w.put(job);
       w.put<std::uint64_t>(first);
       w.put<std::uint64_t>(n);
+      for (std::size_t i = first; i < first + n; ++i) detail::put_inputs(w, p.samples[p.simulate[i]]);
       send(w.bytes(), from, kTagAssign);
       if (n == 0) ++released;
     }

@@ -5,11 +5,11 @@
 // functions with one process.
 //
 // Model: rank 0 runs the command (reads the config, runs the optimiser, writes every file, the
-// archive and stdout); the other ranks serve: each Monte Carlo study of rank 0 is sent to them as
-// a description (the setup and the montecarlo section as YAML, rebuilt and checked on the rank),
-// and rank 0 hands out chunks of run indices on request (dynamic balancing: a rank that is done
-// asks for more), threads inside every rank. Outcomes come back as bytes and land in slot i, so
-// the result is bit-identical to one process for any ranks x threads.
+// archive and stdout); the other ranks serve: for each Monte Carlo study of rank 0 they get the
+// setup (YAML, rebuilt and checked on the rank), then chunks of runs on request, each with its
+// inputs (initial angles, uncertain parameters: prepared once, on rank 0) — dynamic balancing: a
+// rank that is done asks for more — with threads inside every rank. Outcomes come back as bytes
+// and land in slot i, so the result is bit-identical to one process for any ranks x threads.
 //
 //   int main(int argc, char** argv) {
 //     abuopt::parallel::Session mpi(argc, argv);   // MPI only when launched by mpirun
