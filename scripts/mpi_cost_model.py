@@ -82,11 +82,20 @@ def main():
     ap.add_argument("--runs", type=int, nargs="*", default=[4096, 65536])
     ap.add_argument("--latency", type=float, default=5e-6, help="one-way message time [s]")
     ap.add_argument("--service", type=float, default=10e-6, help="dispatcher time per request [s]")
-    ap.add_argument("--per-run", type=float, default=0.3e-6, help="dispatcher time per run [s]")
-    ap.add_argument("--fixed", type=float, default=2e-3, help="serving rank start-up per study [s]")
+    ap.add_argument("--per-run", type=float, default=2e-6, help="dispatcher time per run [s]")
+    ap.add_argument("--fixed", type=float, default=1.2e-3, help="serving rank start-up per study [s]")
     ap.add_argument("--ranks", type=int, nargs="*", default=[1, 2, 16, 32, 64, 128, 256, 512, 1024])
+    ap.add_argument("--spread", type=float, default=0.0,
+                    help="instead of the measured spread: log-uniform run costs with max/min = SPREAD "
+                         "around the measured mean (e.g. 10 for the 10x of issue 11)")
     a = ap.parse_args()
     measured = load_costs(a.runs_csv, a.cpu_seconds)
+    if a.spread > 1:
+        mean = sum(measured) / len(measured)
+        rng = random.Random(2)
+        raw = [a.spread ** rng.random() for _ in measured]
+        k = mean / (sum(raw) / len(raw))
+        measured = [k * r for r in raw]
     mean = sum(measured) / len(measured)
     print(f"measured: {len(measured)} runs, mean {mean * 1e3:.3f} ms, max {max(measured) * 1e3:.3f} ms "
           f"(max/mean {max(measured) / mean:.1f})")
