@@ -1,5 +1,6 @@
-// `mpirun -np 2 abuopt ...` against one process (issue 11): the Monte Carlo JSON and the
-// optimisation's result and history are identical apart from timing fields; a bad config ends
+// `mpirun -np 2 abuopt ...` against one process (issue 11): the Monte Carlo JSON, the
+// optimisation's result and history, and the reproduction's tables are identical apart from
+// timing fields; a bad config ends
 // every rank with the message once and exit 2; a rank that throws, or dies, ends the job within
 // 30 s (every command runs under `timeout 30`: a hang fails the test instead of stalling CI), and
 // after a death the archive keeps the completed evaluations and a rerun resumes from them.
@@ -12,6 +13,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <iostream>
 #include <string>
 
@@ -145,6 +147,25 @@ TEST(MpiCli, OptimizeOverTwoRanksIsIdenticalToOneProcess) {
   EXPECT_EQ(strip(read_json(d1 / "result.json")), strip(read_json(d2 / "result.json")));
   EXPECT_EQ(history_without_timing(d1 / "history.csv"), history_without_timing(d2 / "history.csv"));
   EXPECT_GT(history_without_timing(d2 / "history.csv").size(), 200u);
+}
+
+TEST(MpiCli, ReproduceOverTwoRanksIsIdenticalToOneProcess) {
+  REQUIRE_MPI();
+  const fs::path d1 = fresh_dir("rep1"), d2 = fresh_dir("rep2");
+  const std::string args = "reproduce --only final --runs 64 --out ";
+  const Shell one = shell(plain(args + d1.string() + " --threads 2"));
+  ASSERT_EQ(one.status, 0) << one.output;
+  const Shell two = shell(mpirun(2, args + d2.string() + " --threads 1"));
+  ASSERT_EQ(two.status, 0) << two.output;
+  auto text = [](const fs::path& p) {
+    std::ifstream f(p);
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  };
+  EXPECT_EQ(history_without_timing(d1 / "tables.csv"), history_without_timing(d2 / "tables.csv"));
+  EXPECT_GT(text(d2 / "tables.csv").size(), 100u);
+  // the per-run CSV without its wall-time column
+  EXPECT_EQ(history_without_timing(d1 / "runs" / "final" / "final.csv"),
+            history_without_timing(d2 / "runs" / "final" / "final.csv"));
 }
 
 TEST(MpiCli, ABadConfigEndsEveryRankWithTheMessageOnce) {
