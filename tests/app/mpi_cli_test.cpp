@@ -1,5 +1,5 @@
 // `mpirun -np 2 abuopt ...` against one process (issue 11): the Monte Carlo JSON, the
-// optimisation's result and history, and the reproduction's tables are identical apart from
+// optimisation's result and history, the reproduction's tables and a comparison's runs are identical apart from
 // timing fields; a bad config ends
 // every rank with the message once and exit 2; a rank that throws, or dies, ends the job within
 // 30 s (every command runs under `timeout 30`: a hang fails the test instead of stalling CI), and
@@ -166,6 +166,41 @@ TEST(MpiCli, ReproduceOverTwoRanksIsIdenticalToOneProcess) {
   // the per-run CSV without its wall-time column
   EXPECT_EQ(history_without_timing(d1 / "runs" / "final" / "final.csv"),
             history_without_timing(d2 / "runs" / "final" / "final.csv"));
+}
+
+TEST(MpiCli, CompareOverTwoRanksIsIdenticalToOneProcess) {
+  REQUIRE_MPI();
+  const fs::path cfg = fs::path(ABUOPT_BINARY_DIR) / "mpi_cli_test" / "compare_small.yaml";
+  fs::create_directories(cfg.parent_path());
+  std::ofstream(cfg) << R"(
+problems:
+  - label: startup_profile
+    max_evaluations: 6
+    starts: 2
+    seed: 1
+    startup_profile:
+      montecarlo: {design: lhs, runs: 16, seed: 11}
+      design:
+        segments:
+          - end_frequency_hz: {min: 15, max: 28, x0: 25}
+            duration_s: {min: 0.3, max: 3, x0: 1}
+          - end_frequency_hz: {min: 28, max: 32, x0: 29.5}
+            duration_s: {min: 1, max: 12, x0: 10}
+          - end_frequency_hz: 100
+            duration_s: {min: 1, max: 10, x0: 8}
+      constraints: {max_startup_time_s: 20, max_pct_mi: 50}
+solvers:
+  - {label: COBYLA, algorithm: cobyla}
+  - {label: SAO, algorithm: sao}
+)";
+  const fs::path d1 = fresh_dir("cmp1"), d2 = fresh_dir("cmp2");
+  const Shell one = shell(plain("compare " + cfg.string() + " --out " + d1.string()));
+  ASSERT_EQ(one.status, 0) << one.output;
+  const Shell two = shell(mpirun(2, "compare " + cfg.string() + " --out " + d2.string()));
+  ASSERT_EQ(two.status, 0) << two.output;
+  EXPECT_EQ(history_without_timing(d1 / "runs.csv"), history_without_timing(d2 / "runs.csv"));
+  EXPECT_EQ(history_without_timing(d1 / "convergence.csv"), history_without_timing(d2 / "convergence.csv"));
+  EXPECT_GT(history_without_timing(d2 / "runs.csv").size(), 100u);
 }
 
 TEST(MpiCli, ABadConfigEndsEveryRankWithTheMessageOnce) {

@@ -245,6 +245,8 @@ namespace abuopt::problems {
 // The problem as the optimisers see it: a StartupProfileProblem, or with
 // constraints.penalty_weight > 0 its exact-L1-penalty form (opt::PenaltyProblem owning it). Throws
 // ConfigError for invalid settings.
-std::unique_ptr<opt::Problem> make_startup_profile_problem(const StartupProfileSettings& settings);
+// `runner`: where its Monte Carlo studies run (StartupProfileProblem::set_monte_carlo_runner).
+std::unique_ptr<opt::Problem> make_startup_profile_problem(const StartupProfileSettings& settings,
+                                                           std::shared_ptr<BatchRunner> runner = nullptr);
 
 }  // namespace abuopt::problems
