@@ -10,9 +10,10 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/output_file.hpp"
-#include "abuopt/common/suggest.hpp"
-#include "abuopt/studies/terms.hpp"
 #include "abuopt/common/provenance.hpp"
+#include "abuopt/common/suggest.hpp"
+#include "abuopt/parallel/parallel.hpp"
+#include "abuopt/studies/terms.hpp"
 #include "commands/commands.hpp"
 
 namespace abuopt::app {
@@ -56,10 +57,9 @@ std::string hint_for(CLI::App& app, int argc, char** argv) {
 
 }  // namespace abuopt::app
 
-int main(int argc, char** argv) {
-  // A file-size limit (ulimit -f) must fail a write like a full disk does (exit 4, nothing
-  // half-written under the final name), not kill the process with SIGXFSZ.
-  std::signal(SIGXFSZ, SIG_IGN);
+namespace {
+
+int run_cli(int argc, char** argv) {
   CLI::App app{
       "abuopt: simulate an Automatic Balancing Unit (ABU) during startup, evaluate startup profiles\n"
       "by Monte Carlo over initial ball positions, and optimise them.\n"
@@ -112,4 +112,17 @@ int main(int argc, char** argv) {
     return 3;
   }
   return abuopt::app::exit_code();
+}
+
+}  // namespace
+
+// Under mpirun, rank 0 runs the command and the other ranks serve its Monte Carlo studies
+// (abuopt/parallel/parallel.hpp); without mpirun this is a plain program.
+int main(int argc, char** argv) {
+  // A file-size limit (ulimit -f) must fail a write like a full disk does (exit 4, nothing
+  // half-written under the final name), not kill the process with SIGXFSZ.
+  std::signal(SIGXFSZ, SIG_IGN);
+  abuopt::parallel::Session mpi(argc, argv);
+  if (!mpi.is_root()) return mpi.serve();
+  return mpi.finish(run_cli(argc, argv));
 }

@@ -11,6 +11,7 @@ packages=(
   libnlopt-dev libnlopt-cxx-dev  # NLopt optimisers (C API + C++ wrapper; the CMake config is in libnlopt-dev)
   coinor-libipopt-dev    # Ipopt
   libsqlite3-dev         # evaluation archive
+  libopenmpi-dev openmpi-bin  # MPI across ranks (parallel/, option ABUOPT_MPI; docs/cluster.md)
   libcli11-dev           # command line parsing
   nlohmann-json3-dev     # JSON output (--json, summaries)
   libgtest-dev           # tests

@@ -36,6 +36,7 @@
 #include "abuopt/optimizer/benchmarking.hpp"
 #include "abuopt/optimizer/benchmarks/benchmark_factory.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
+#include "abuopt/parallel/parallel.hpp"
 #include "commands/commands.hpp"
 
 namespace abuopt::app {
@@ -67,7 +68,11 @@ opt::ProblemSpec read_startup_profile_problem(YamlReader& r) {
   section.finish();
   problems::StartupProfileProblem check(settings);  // a bad design is a ConfigError now, before any run
   spec.label = r.get_string_or("label", "startup_profile");
-  spec.make = [settings] { return problems::make_startup_profile_problem(settings); };
+  // under mpirun every evaluation's Monte Carlo is spread over the ranks (the runs then go one at a
+  // time: run_compare sets threads 1)
+  std::shared_ptr<BatchRunner> runner;
+  if (parallel::session() && parallel::session()->size() > 1) runner = parallel::make_runner(settings.threads);
+  spec.make = [settings, runner] { return problems::make_startup_profile_problem(settings, runner); };
   read_run_settings(r, spec);
   r.finish();
   return spec;
@@ -115,6 +120,8 @@ int run_compare(const CompareArgs& a) {
   for (YamlReader& p : root.children("problems")) setup.problems.push_back(read_problem(p));
   for (YamlReader& s : root.children("solvers")) setup.solvers.push_back(opt::read_solver_spec(s));
   root.finish();
+  // under mpirun the ranks serve one Monte Carlo at a time: the runs go one after another
+  if (parallel::session() && parallel::session()->size() > 1) setup.threads = 1;
   if (setup.problems.empty()) throw ConfigError("problems", "<missing>", "must list at least one problem");
   if (setup.solvers.empty()) throw ConfigError("solvers", "<missing>", "must list at least one solver");
 

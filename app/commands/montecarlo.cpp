@@ -24,6 +24,7 @@
 #include "abuopt/core/monte_carlo.hpp"
 #include "abuopt/core/monte_carlo_stats.hpp"
 #include "abuopt/core/simulation_config.hpp"
+#include "abuopt/parallel/parallel.hpp"
 #include "abuopt/studies/terms.hpp"
 #include "commands/commands.hpp"
 
@@ -170,12 +171,9 @@ int run_montecarlo(const MonteCarloArgs& a) {
   if (!a.out.empty()) lock.emplace(a.out);
 
   const MonteCarloStudy& s = cfg.study;
-  auto sim = std::make_shared<const Simulator>(s.setup);  // validates the setup
-  const SampleFunction sample = [sim](const std::vector<double>& beta0, const RunOverrides& o) {
-    return sim->run(beta0, o);
-  };
-  const double end_time_s = sim->end_time_s();
-  ThreadPoolRunner runner(cfg.threads);
+  const double end_time_s = Simulator(s.setup).end_time_s();  // validates the setup
+  // threads per process; under mpirun the runs are spread over every rank (parallel.hpp)
+  const std::shared_ptr<BatchRunner> runner = parallel::make_runner(cfg.threads);
 
   ProgressReporter bar("Monte Carlo", "runs", s.runs, a.progress ? ProgressMode::Always : ProgressMode::Auto);
   ProgressCallback progress;
@@ -184,7 +182,7 @@ int run_montecarlo(const MonteCarloArgs& a) {
       bar.set_total(total);
       bar.update(done);
     };
-  const MonteCarloResult result = run_monte_carlo(s, sample, runner, progress);
+  const MonteCarloResult result = run_monte_carlo(s, *runner, progress);
   bar.finish();
   const MonteCarloStats stats = compute_statistics(result);
 

@@ -29,6 +29,7 @@
 #include "abuopt/optimizer/minimize.hpp"
 #include "abuopt/optimizer/optimizer_options.hpp"
 #include "abuopt/optimizer/penalty_problem.hpp"
+#include "abuopt/parallel/parallel.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
 #include "abuopt/studies/out_of_sample.hpp"
 #include "abuopt/studies/terms.hpp"
@@ -205,6 +206,9 @@ int run_optimize(const OptimizeArgs& a) {
   LoadedConfig cfg = load_config(a);
   StartupProfileProblem problem(cfg.settings);
   const auto& st = problem.settings();
+  // under mpirun every Monte Carlo (the evaluations and the validation) is spread over the ranks
+  if (parallel::session() && parallel::session()->size() > 1)
+    problem.set_monte_carlo_runner(parallel::make_runner(st.threads));
   // What the optimiser sees: the problem, or its penalty form (constraints.penalty_weight > 0).
   std::optional<opt::PenaltyProblem> penalised;
   if (st.constraints.penalty_weight > 0) penalised.emplace(problem, st.constraints.penalty_weight);

@@ -16,6 +16,7 @@
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/progress.hpp"
 #include "abuopt/studies/reproduction.hpp"
+#include "abuopt/parallel/parallel.hpp"
 #include "abuopt/studies/terms.hpp"
 #include "commands/commands.hpp"
 
@@ -84,6 +85,8 @@ int run_reproduce(const ReproduceArgs& a) {
   ReproductionOptions opt;
   opt.out_dir = a.out.empty() ? default_out_dir() : a.out;
   opt.threads = a.threads ? static_cast<std::size_t>(*a.threads) : 0;
+  // under mpirun every case's Monte Carlo is spread over the ranks
+  if (parallel::session() && parallel::session()->size() > 1) opt.runner = parallel::make_runner(opt.threads);
   opt.plots = !a.no_plots;
   opt.command_line = command_line(a, opt.out_dir);
   if (a.runs) opt.runs_note = override_runs(tables, static_cast<std::size_t>(*a.runs), "--runs");

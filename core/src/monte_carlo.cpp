@@ -139,32 +139,57 @@ MonteCarloSample run_one(const MonteCarloStudy& s, std::size_t index, const Samp
   return out;
 }
 
+PreparedStudy prepare_study(const MonteCarloStudy& s) {
+  validate(s);
+  std::vector<std::vector<double>> points = generate_initial_conditions(study_design(s));
+  PreparedStudy p;
+  p.samples.resize(s.runs);
+  for (std::size_t i = 0; i < s.runs; ++i) p.samples[i] = make_sample(s, i, std::move(points[i]));
+  const std::vector<std::size_t> same = reuse_map(s, p.samples);
+  for (std::size_t i = 0; i < s.runs; ++i) {
+    p.samples[i].reused = same[i] != i;
+    p.samples[i].reused_from = same[i];
+    if (same[i] == i) p.simulate.push_back(i);
+  }
+  return p;
+}
+
+namespace {
+// The reused runs take their outcome from the run they exchange balls with.
+void fill_reused(std::vector<MonteCarloSample>& samples) {
+  for (MonteCarloSample& smp : samples)
+    if (smp.reused) smp.outcome = permuted_outcome(samples[smp.reused_from], smp);
+}
+}  // namespace
+
 MonteCarloResult run_monte_carlo(const MonteCarloStudy& s, const SampleFunction& sample, BatchRunner& runner,
                                  const ProgressCallback& progress) {
-  validate(s);
   const auto start = std::chrono::steady_clock::now();
-  std::vector<std::vector<double>> points = generate_initial_conditions(study_design(s));
-
+  PreparedStudy p = prepare_study(s);
   MonteCarloResult result;
-  result.samples.resize(s.runs);
-  for (std::size_t i = 0; i < s.runs; ++i) result.samples[i] = make_sample(s, i, std::move(points[i]));
-  const std::vector<std::size_t> same = reuse_map(s, result.samples);
-  std::vector<std::size_t> simulate;  // the runs that are paid for
-  for (std::size_t i = 0; i < s.runs; ++i) {
-    result.samples[i].reused = same[i] != i;
-    result.samples[i].reused_from = same[i];
-    if (same[i] == i) simulate.push_back(i);
-  }
   result.concurrency = runner.concurrency();
   runner.run(
-      simulate.size(),
+      p.simulate.size(),
       [&](std::size_t k) {
-        MonteCarloSample& smp = result.samples[simulate[k]];
+        MonteCarloSample& smp = p.samples[p.simulate[k]];
         smp.outcome = sample(smp.beta0, smp.overrides);
       },
       progress);
-  for (std::size_t i = 0; i < s.runs; ++i)
-    if (same[i] != i) result.samples[i].outcome = permuted_outcome(result.samples[same[i]], result.samples[i]);
+  fill_reused(p.samples);
+  result.samples = std::move(p.samples);
+  result.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+MonteCarloResult run_monte_carlo_study(const MonteCarloStudy& s, StudyRunner& runner,
+                                       const ProgressCallback& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  PreparedStudy p = prepare_study(s);
+  MonteCarloResult result;
+  result.concurrency = runner.concurrency();
+  runner.run_study(s, p, progress);
+  fill_reused(p.samples);
+  result.samples = std::move(p.samples);
   result.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

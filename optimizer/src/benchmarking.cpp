@@ -1,8 +1,9 @@
 // Comparison of optimisers: runs, solve matrix, data and performance profiles, CSV and gnuplot.
 #include "abuopt/optimizer/benchmarking.hpp"
 
+#include "abuopt/optimizer/evaluation_scheduler.hpp"
+
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <exception>
 #include <filesystem>
@@ -12,7 +13,6 @@
 #include <random>
 #include <set>
 #include <sstream>
-#include <thread>
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/gnuplot.hpp"
@@ -203,6 +203,8 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
         o.seed = spec.seed + static_cast<unsigned long>(k);
         o.keep_history = true;
         o.handle_sigint = o.handle_sigint && setup.threads <= 1;  // one handler owner at a time
+        // runs already go at once: their evaluations go one at a time unless the solver says otherwise
+        if (setup.threads > 1 && o.evaluation_threads == 0) o.evaluation_threads = 1;
         RunRecord rec;
         rec.problem = spec.label;
         rec.solver = solver.label;
@@ -232,26 +234,8 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
         out.runs[first_run + t] = std::move(rec);
       }
     };
-    const std::size_t workers = std::min<std::size_t>(std::max(1, setup.threads), tasks);
-    if (workers <= 1) {
-      for (std::size_t t = 0; t < tasks; ++t) run_task(t);
-    } else {
-      std::atomic<std::size_t> next{0};
-      std::vector<std::exception_ptr> errors(workers);
-      std::vector<std::thread> pool;
-      for (std::size_t w = 0; w < workers; ++w)
-        pool.emplace_back([&, w] {
-          try {
-            for (std::size_t t = next++; t < tasks; t = next++) run_task(t);
-          } catch (...) {
-            errors[w] = std::current_exception();  // rethrown below, as a serial run would
-            next = tasks;
-          }
-        });
-      for (std::thread& th : pool) th.join();
-      for (const std::exception_ptr& e : errors)
-        if (e) std::rethrow_exception(e);
-    }
+    // the runs are one batch of independent tasks on the evaluation scheduler's threads
+    ThreadScheduler(static_cast<std::size_t>(std::max(1, setup.threads))).run(tasks, run_task);
     // the reference value f*
     double f_star = kInf;
     std::string source = "none";

@@ -493,18 +493,49 @@ ArchivedProblem::ArchivedProblem(Problem& inner, EvaluationArchive& archive) : i
   archive_.check_signature(inner_);
 }
 
-Evaluation ArchivedProblem::evaluate(const std::vector<double>& x) {
+Evaluation ArchivedProblem::evaluate(const std::vector<double>& x) { return evaluate_shared(x, 1); }
+
+Evaluation ArchivedProblem::evaluate_shared(const std::vector<double>& x, std::size_t concurrent) {
   if (std::optional<Evaluation> hit = archive_.find(x)) {
     ++hits_;
     return *hit;
   }
   const auto t0 = std::chrono::steady_clock::now();
-  Evaluation e = inner_.evaluate(x);  // an exception propagates and nothing is stored
+  // an exception propagates and nothing is stored
+  Evaluation e = concurrent > 1 ? inner_.evaluate_shared(x, concurrent) : inner_.evaluate(x);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   e.from_archive = false;
   archive_.store(x, e, wall);
   ++misses_;
   return e;
+}
+
+std::vector<BatchEvaluation> ArchivedProblem::evaluate_batch(const std::vector<std::vector<double>>& xs,
+                                                             EvaluationScheduler& scheduler) {
+  std::vector<BatchEvaluation> out(xs.size());
+  std::vector<std::size_t> miss;
+  std::vector<std::vector<double>> miss_x;
+  for (std::size_t i = 0; i < xs.size(); ++i) {
+    if (std::optional<Evaluation> hit = archive_.find(xs[i])) {
+      ++hits_;
+      out[i].evaluation = std::move(*hit);
+    } else {
+      miss.push_back(i);
+      miss_x.push_back(xs[i]);
+    }
+  }
+  if (miss.empty()) return out;
+  std::vector<BatchEvaluation> computed = inner_.evaluate_batch(miss_x, scheduler);
+  for (std::size_t k = 0; k < miss.size(); ++k) {
+    BatchEvaluation& b = computed[k];
+    if (!b.error) {  // a point whose evaluation threw is not stored
+      b.evaluation.from_archive = false;
+      archive_.store(miss_x[k], b.evaluation, b.wall_time_s);
+      ++misses_;
+    }
+    out[miss[k]] = std::move(b);
+  }
+  return out;
 }
 
 }  // namespace abuopt::opt

@@ -6,6 +6,7 @@
 #include <exception>
 #include <limits>
 #include <mutex>
+#include <stdexcept>
 
 namespace abuopt::opt::detail {
 
@@ -56,6 +57,7 @@ EvaluationDriver::EvaluationDriver(Problem& problem, const OptimizerOptions& opt
       n_ineq_(problem.inequality_names().size()),
       n_eq_(problem.equality_names().size()),
       start_(std::chrono::steady_clock::now()) {
+  scheduler_ = options.scheduler ? options.scheduler : std::make_shared<ThreadScheduler>(options.evaluation_threads);
   for (const Variable& v : variables_) {
     lower_y_.push_back(v.lower / v.scale);
     upper_y_.push_back(v.upper / v.scale);
@@ -94,10 +96,10 @@ bool EvaluationDriver::check_limits() {
   return stop_reason_.has_value();
 }
 
-const EvaluatedPoint* EvaluationDriver::evaluate(const double* y, bool for_gradient) {
+std::vector<double> EvaluationDriver::clip(const double* y, bool& clipped) const {
   const std::size_t n = variables_.size();
   std::vector<double> x(n);
-  bool clipped = false;
+  clipped = false;
   for (std::size_t i = 0; i < n; ++i) {
     const Variable& v = variables_[i];
     double xi = std::isnan(y[i]) ? 0.5 * (v.lower + v.upper) : y[i] * v.scale;
@@ -113,28 +115,111 @@ const EvaluatedPoint* EvaluationDriver::evaluate(const double* y, bool for_gradi
     }
     x[i] = xi;
   }
-  if (auto it = index_.find(x); it != index_.end()) {
-    ++repeats_;
-    return &points_[it->second];
-  }
-  if (check_limits()) return nullptr;
-  if (clipped) ++clipped_;
+  return x;
+}
 
+const EvaluatedPoint* EvaluationDriver::evaluate(const double* y, bool for_gradient) {
+  const std::size_t n = variables_.size();
+  return evaluate_batch({std::vector<double>(y, y + n)}, for_gradient).front();
+}
+
+std::vector<const EvaluatedPoint*> EvaluationDriver::evaluate_batch(const std::vector<std::vector<double>>& ys,
+                                                                    bool for_gradient) {
+  // ---- plan, in input order: repeats, new points, and how many of those the budget admits ----
+  enum class Kind { Repeat, New, Refused };
+  struct Item {
+    Kind kind = Kind::Refused;
+    std::vector<double> x;
+    bool clipped = false;
+    std::size_t slot = 0;  // New: index into `fresh`
+  };
+  std::vector<Item> items(ys.size());
+  std::vector<std::vector<double>> fresh;
+  std::map<std::vector<double>, std::size_t> in_batch;  // x -> slot of its first occurrence
+  bool refused = check_limits();
+  for (std::size_t i = 0; i < ys.size(); ++i) {
+    if (ys[i].size() != variables_.size())
+      throw std::invalid_argument("EvaluationDriver::evaluate_batch: a point of the wrong size");
+    Item& it = items[i];
+    it.x = clip(ys[i].data(), it.clipped);
+    if (index_.count(it.x) || in_batch.count(it.x)) {
+      it.kind = Kind::Repeat;
+      continue;
+    }
+    // what check_limits() would say before this evaluation (the time limit and an interrupt are
+    // checked once per batch, above)
+    if (refused || evaluations_ + static_cast<long>(fresh.size()) >= options_.max_evaluations) {
+      refused = true;
+      it.kind = Kind::Refused;
+      continue;
+    }
+    it.kind = Kind::New;
+    it.slot = fresh.size();
+    in_batch.emplace(it.x, it.slot);
+    fresh.push_back(it.x);
+  }
+
+  // ---- evaluate the new points (at once where the problem and the scheduler allow) ----
+  std::vector<BatchEvaluation> computed;
+  if (!fresh.empty()) {
+    if (fresh.size() == 1) {  // one point: on this thread, as a plain evaluate()
+      computed.resize(1);
+      const auto t0 = std::chrono::steady_clock::now();
+      try {
+        computed[0].evaluation = problem_.evaluate(fresh[0]);
+      } catch (...) {
+        computed[0].error = std::current_exception();
+      }
+      computed[0].wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    } else {
+      computed = problem_.evaluate_batch(fresh, *scheduler_);
+      if (computed.size() != fresh.size())
+        throw std::logic_error("Problem::evaluate_batch returned " + std::to_string(computed.size()) +
+                               " results for " + std::to_string(fresh.size()) + " points");
+    }
+  }
+
+  // ---- record in input order, as one evaluation after another would have ----
+  std::vector<const EvaluatedPoint*> out(ys.size(), nullptr);
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    Item& it = items[i];
+    if (auto found = index_.find(it.x); found != index_.end()) {
+      ++repeats_;
+      out[i] = &points_[found->second];
+      continue;
+    }
+    if (check_limits()) continue;  // stopped (by an earlier point of the batch, or a limit)
+    if (it.kind != Kind::New) continue;  // cannot happen: refused points come after a limit
+    out[i] = record(std::move(it.x), it.clipped, std::move(computed[it.slot]), for_gradient);
+  }
+  return out;
+}
+
+const EvaluatedPoint* EvaluationDriver::record(std::vector<double> x, bool clipped, BatchEvaluation b,
+                                               bool for_gradient) {
+  if (clipped) ++clipped_;
   EvaluatedPoint p;
   p.x = x;
   bool threw = false;
-  const auto t0 = std::chrono::steady_clock::now();
-  try {
-    p.e = problem_.evaluate(x);
-    check_evaluation_shape(n_ineq_, n_eq_, p.e);
-  } catch (const std::exception& ex) {
-    p.e = Evaluation::failed(std::string("evaluation threw: ") + ex.what());
+  if (b.error) {
     threw = true;
-  } catch (...) {
-    p.e = Evaluation::failed("evaluation threw a non-standard exception");
-    threw = true;
+    try {
+      std::rethrow_exception(b.error);
+    } catch (const std::exception& ex) {
+      p.e = Evaluation::failed(std::string("evaluation threw: ") + ex.what());
+    } catch (...) {
+      p.e = Evaluation::failed("evaluation threw a non-standard exception");
+    }
+  } else {
+    p.e = std::move(b.evaluation);
+    try {
+      check_evaluation_shape(n_ineq_, n_eq_, p.e);
+    } catch (const std::exception& ex) {
+      p.e = Evaluation::failed(std::string("evaluation threw: ") + ex.what());
+      threw = true;
+    }
   }
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double wall = b.wall_time_s;
   if (!p.e.ok) p.e.objective = kInf;
   if (std::isnan(p.e.objective)) {
     p.e.ok = false;
@@ -258,23 +343,34 @@ bool EvaluationDriver::derivatives(const double* y_in, const EvaluatedPoint& bas
       jac_ineq[i * n + j] = (a.e.inequality[i] - b.e.inequality[i]) / dy;
     for (std::size_t i = 0; jac_eq && i < n_eq_; ++i) jac_eq[i * n + j] = (a.e.equality[i] - b.e.equality[i]) / dy;
   };
+  // The first neighbour(s) of every coordinate are independent: one batch (evaluate_batch keeps
+  // the order j = 0, 1, ... of one-at-a-time evaluation). Only the fallback of a one-sided
+  // difference whose neighbour failed (the other side) is evaluated afterwards, one at a time.
+  struct Plan {
+    bool central = false;
+    double delta = 0;          // one-sided step (0: the box is degenerate: zero derivative)
+    std::size_t first = 0;     // index of the first neighbour in the batch
+    double up = 0, down = 0;   // the steps actually taken in floating point
+  };
+  std::vector<Plan> plan(n);
+  std::vector<std::vector<double>> batch;
+  auto add = [&](std::size_t j, double delta) {
+    yp[j] = y[j] + delta;
+    const double actual = yp[j] - y[j];
+    batch.push_back(yp);
+    yp[j] = y[j];
+    return actual;
+  };
   for (std::size_t j = 0; j < n; ++j) {
+    Plan& pl = plan[j];
     const double h = fd_step_ * std::max(std::fabs(y[j]), 1.0);
     const bool room_up = y[j] + h <= upper_y_[j];
     const bool room_down = y[j] - h >= lower_y_[j];
-    double up = 0, down = 0;
+    pl.first = batch.size();
     if (options_.finite_difference == FiniteDifference::Central && room_up && room_down) {
-      const EvaluatedPoint* a = neighbour(j, h, up);
-      if (!a) return false;
-      const EvaluatedPoint* b = neighbour(j, -h, down);
-      if (!b) return false;
-      if (a->e.ok && b->e.ok) {
-        set(j, *a, *b, up - down);
-        continue;
-      }
-      if (a->e.ok) set(j, *a, base, up);
-      else if (b->e.ok) set(j, base, *b, -down);
-      else zero(j);
+      pl.central = true;
+      pl.up = add(j, h);
+      pl.down = add(j, -h);
       continue;
     }
     // one-sided: forward if there is room above, else backward
@@ -282,13 +378,34 @@ bool EvaluationDriver::derivatives(const double* y_in, const EvaluatedPoint& bas
     if (!room_up && room_down) delta = -h;
     if (!room_up && !room_down)  // a box narrower than the step: go to the farther bound
       delta = upper_y_[j] - y[j] >= y[j] - lower_y_[j] ? upper_y_[j] - y[j] : lower_y_[j] - y[j];
+    pl.delta = delta;
+    if (delta != 0.0) pl.up = add(j, delta);
+  }
+  const std::vector<const EvaluatedPoint*> done = evaluate_batch(batch, true);
+  for (const EvaluatedPoint* p : done)
+    if (!p) return false;
+
+  for (std::size_t j = 0; j < n; ++j) {
+    const Plan& pl = plan[j];
+    if (pl.central) {
+      const EvaluatedPoint* a = done[pl.first];
+      const EvaluatedPoint* b = done[pl.first + 1];
+      if (a->e.ok && b->e.ok) {
+        set(j, *a, *b, pl.up - pl.down);
+        continue;
+      }
+      if (a->e.ok) set(j, *a, base, pl.up);
+      else if (b->e.ok) set(j, base, *b, -pl.down);
+      else zero(j);
+      continue;
+    }
+    const double delta = pl.delta;
     if (delta == 0.0) {
       zero(j);
       continue;
     }
-    double actual = 0;
-    const EvaluatedPoint* a = neighbour(j, delta, actual);
-    if (!a) return false;
+    double actual = pl.up;
+    const EvaluatedPoint* a = done[pl.first];
     if (a->e.ok && actual != 0.0) {
       if (actual > 0) set(j, *a, base, actual);
       else set(j, base, *a, -actual);

@@ -7,10 +7,12 @@
 #include <deque>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "abuopt/optimizer/evaluation_scheduler.hpp"
 #include "abuopt/optimizer/minimize.hpp"
 
 namespace abuopt::opt::detail {
@@ -49,10 +51,25 @@ class EvaluationDriver {
   const std::vector<double>& lower_scaled() const { return lower_y_; }
   const std::vector<double>& upper_scaled() const { return upper_y_; }
   std::vector<double> to_scaled(const std::vector<double>& x) const;
+  // The point (real units) that evaluate(y) evaluates: y * scale clipped into the bounds.
+  std::vector<double> evaluated_x(const std::vector<double>& y) const {
+    bool clipped = false;
+    return clip(y.data(), clipped);
+  }
 
   // Evaluates at scaled point y (length n). Returns nullptr, without evaluating, once the run is
   // stopped (budget, time, interrupt, callback, error). The pointer stays valid for the run.
   const EvaluatedPoint* evaluate(const double* y, bool for_gradient = false);
+
+  // Evaluates independent scaled points at once (evaluation_scheduler.hpp); out[i] is what
+  // evaluate(ys[i]) would have returned had the points been evaluated one after another in input
+  // order: repeats are answered from memory, the budget admits the first new points only, the
+  // records, counts, callback and stop checks follow input order, and everything after the point
+  // at which the run stopped is nullptr (and not recorded). Only wall times depend on the
+  // scheduler. Points evaluated after a stop (target, callback, exception) are discarded here;
+  // an ArchivedProblem has stored them.
+  std::vector<const EvaluatedPoint*> evaluate_batch(const std::vector<std::vector<double>>& ys,
+                                                    bool for_gradient = false);
 
   // Finite-difference derivatives in scaled coordinates at y, whose evaluation is `base`:
   // grad_f (n), jac_ineq (n_inequality x n, row-major), jac_eq (n_equality x n); any may be null.
@@ -79,6 +96,10 @@ class EvaluationDriver {
 
  private:
   bool check_limits();  // sets the stop reason when a limit is reached; true if stopped
+  // y (scaled) -> x (real units) clipped into the bounds; `clipped` when it moved.
+  std::vector<double> clip(const double* y, bool& clipped) const;
+  // Counts and records a computed point (the bookkeeping of evaluate()).
+  const EvaluatedPoint* record(std::vector<double> x, bool clipped, BatchEvaluation b, bool for_gradient);
 
   Problem& problem_;
   const OptimizerOptions& options_;
@@ -87,6 +108,7 @@ class EvaluationDriver {
   std::size_t n_ineq_ = 0, n_eq_ = 0;
   std::vector<double> lower_y_, upper_y_;
   double fd_step_;
+  std::shared_ptr<EvaluationScheduler> scheduler_;
   std::chrono::steady_clock::time_point start_;
 
   std::deque<EvaluatedPoint> points_;

@@ -81,6 +81,9 @@ void describe_fields(FieldArchive& a, OptimizerOptions& o) {
   a.field("print_level", o.print_level, Rule::in_range(0, 12));
   a.field("handle_sigint", o.handle_sigint);
   a.field("keep_history", o.keep_history);
+  FieldOptions eval_threads = FieldOptions::not_identity();
+  eval_threads.enabled = a.reading() || o.evaluation_threads != 0;  // 0 (the default) is never written
+  a.field("evaluation_threads", o.evaluation_threads, Rule::in_range(0, 1024), eval_threads);
   // the sao section is written with algorithm SAO; reading it is read_optimizer_options' job (the
   // settings may come from two places)
   std::string upper = o.algorithm;

@@ -1,12 +1,15 @@
 #include "abuopt/optimizer/problem.hpp"
 
+#include <algorithm>
 #include <charconv>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <set>
 #include <stdexcept>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/optimizer/evaluation_scheduler.hpp"
 
 namespace abuopt::opt {
 
@@ -32,6 +35,29 @@ std::vector<double> Problem::initial_point() const {
   return x;
 }
 
+Evaluation Problem::evaluate_shared(const std::vector<double>& x, std::size_t) { return evaluate(x); }
+
+std::vector<BatchEvaluation> Problem::evaluate_batch(const std::vector<std::vector<double>>& xs,
+                                                     EvaluationScheduler& scheduler) {
+  std::vector<BatchEvaluation> out(xs.size());
+  const bool concurrent = thread_safe() && xs.size() > 1 && scheduler.concurrency() > 1;
+  const std::size_t share = concurrent ? std::min(xs.size(), scheduler.concurrency()) : 1;
+  auto one = [&](std::size_t i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      out[i].evaluation = concurrent ? evaluate_shared(xs[i], share) : evaluate(xs[i]);
+    } catch (...) {
+      out[i].error = std::current_exception();
+    }
+    out[i].wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+  if (concurrent)
+    scheduler.run(xs.size(), one);
+  else
+    for (std::size_t i = 0; i < xs.size(); ++i) one(i);
+  return out;
+}
+
 FunctionProblem::FunctionProblem(std::string name, std::vector<Variable> variables, Function function,
                                  std::vector<std::string> inequality_names,
                                  std::vector<std::string> equality_names)
@@ -52,6 +78,11 @@ FunctionProblem& FunctionProblem::set_initial_point(std::vector<double> x0) {
 
 FunctionProblem& FunctionProblem::set_best_known(BestKnown best) {
   best_known_ = std::move(best);
+  return *this;
+}
+
+FunctionProblem& FunctionProblem::set_thread_safe(bool safe) {
+  thread_safe_ = safe;
   return *this;
 }
 

@@ -155,29 +155,47 @@ bool SaoRun::fill_region(SurrogateKind basis) {
     return d;
   };
   std::vector<bool> used(candidates.size(), false);
+  // The design's points are independent: they are chosen as the one-at-a-time loop would choose
+  // them if every one turned out ok (the choice never looks at the values), evaluated as one
+  // batch (EvaluationDriver::evaluate_batch), and the choice goes on only if some failed.
   while (count < wanted) {
-    // the first candidate (in preference order) that is not covered by a known point; among the
-    // preferred design (before the LHS filler) the farthest one from the known points
-    std::size_t best = candidates.size();
-    double best_d = -1;
-    for (std::size_t k = 0; k < candidates.size(); ++k) {
-      if (used[k]) continue;
-      const double d = distance_to_occupied(candidates[k]);
-      if (d < sao_.reuse_distance) {
-        used[k] = true;
-        continue;
+    std::vector<std::vector<double>> batch;
+    for (int assumed = count; assumed < wanted; ++assumed) {
+      // the first candidate (in preference order) that is not covered by a known point; among the
+      // preferred design (before the LHS filler) the farthest one from the known points
+      std::size_t best = candidates.size();
+      double best_d = -1;
+      for (std::size_t k = 0; k < candidates.size(); ++k) {
+        if (used[k]) continue;
+        const double d = distance_to_occupied(candidates[k]);
+        if (d < sao_.reuse_distance) {
+          used[k] = true;
+          continue;
+        }
+        if (d > best_d) {
+          best_d = d;
+          best = k;
+        }
       }
-      if (d > best_d) {
-        best_d = d;
-        best = k;
-      }
+      if (best == candidates.size()) break;
+      used[best] = true;
+      batch.push_back(to_y(from_s(candidates[best])));
+      occupied.push_back(to_s(to_z(driver_.evaluated_x(batch.back()))));  // exactly where it will be
     }
-    if (best == candidates.size()) break;
-    used[best] = true;
-    const auto idx = evaluate(from_s(candidates[best]));
-    if (!idx) return false;
-    occupied.push_back(to_s(known_[*idx].z));
-    if (known_[*idx].ok) ++count;
+    if (batch.empty()) break;
+    const std::vector<const EvaluatedPoint*> done = driver_.evaluate_batch(batch);
+    for (const EvaluatedPoint* p : done) {
+      if (!p) return false;
+      std::size_t idx = 0;
+      if (auto it = by_driver_point_.find(p); it != by_driver_point_.end()) {
+        idx = it->second;
+      } else {
+        known_.push_back(make_point(to_z(p->x), p->e));
+        idx = known_.size() - 1;
+        by_driver_point_.emplace(p, idx);
+      }
+      if (known_[idx].ok) ++count;
+    }
   }
   // a linear model must be determined: add axial points until [1 s] has full column rank
   auto rank = [&] {

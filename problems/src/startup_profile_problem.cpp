@@ -319,8 +319,10 @@ StartupProfileProblem::StartupProfileProblem(StartupProfileSettings settings) : 
 
 std::vector<std::string> StartupProfileProblem::inequality_names() const { return constraint_names_; }
 
-std::unique_ptr<opt::Problem> make_startup_profile_problem(const StartupProfileSettings& settings) {
+std::unique_ptr<opt::Problem> make_startup_profile_problem(const StartupProfileSettings& settings,
+                                                           std::shared_ptr<BatchRunner> runner) {
   auto problem = std::make_unique<StartupProfileProblem>(settings);
+  if (runner) problem->set_monte_carlo_runner(std::move(runner));
   const double w = settings.constraints.penalty_weight;
   if (w > 0) return std::make_unique<opt::PenaltyProblem>(std::move(problem), w);
   return problem;
@@ -359,6 +361,14 @@ opt::Evaluation StartupProfileProblem::evaluate(const std::vector<double>& x) {
   return evaluate_profile(profile_at(x));
 }
 
+opt::Evaluation StartupProfileProblem::evaluate_shared(const std::vector<double>& x, std::size_t concurrent) {
+  if (x.size() != variables_.size() || concurrent <= 1) return evaluate(x);
+  const std::size_t all = settings_.threads == 0 ? hardware_threads() : settings_.threads;
+  const std::size_t share = std::max<std::size_t>(1, all / concurrent);
+  return evaluate_with_threads(profile_at(x), settings_.study.design, settings_.study.runs, settings_.study.seed,
+                               share);
+}
+
 opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& profile) const {
   return evaluate_profile(profile, settings_.study.design, settings_.study.runs, settings_.study.seed);
 }
@@ -376,6 +386,12 @@ opt::Evaluation StartupProfileProblem::evaluate_out_of_sample(const StartupProfi
 opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& profile,
                                                         const InitialConditionDesign& design, std::size_t runs,
                                                         std::uint64_t seed) const {
+  return evaluate_with_threads(profile, design, runs, seed, settings_.threads);
+}
+
+opt::Evaluation StartupProfileProblem::evaluate_with_threads(const StartupProfile& profile,
+                                                            const InitialConditionDesign& design, std::size_t runs,
+                                                            std::uint64_t seed, std::size_t threads) const {
   // Guard: a profile whose durations are not > 0 (or values not finite) is never simulated.
   const auto& segs = profile.segments();
   for (std::size_t i = 0; i < segs.size(); ++i) {
@@ -424,7 +440,8 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
   else
     for (double mu : os.robust_friction_mu) passes.push_back(mu);
 
-  ThreadPoolRunner runner(settings_.threads);
+  ThreadPoolRunner own_runner(threads);
+  BatchRunner& runner = runner_ ? *runner_ : own_runner;
   std::vector<MonteCarloSample> pooled;
   std::vector<double> objectives, pass_pct_mi;
   double wall = 0;

@@ -38,7 +38,9 @@ ReproductionReport run_reproduction(const std::vector<ReproductionTable>& tables
   write_text_file(report.tables_csv_path, tables_csv);
   std::string tables_contact_csv;
 
-  ThreadPoolRunner runner(opt.threads);
+  const std::shared_ptr<BatchRunner> runner_owner =
+      opt.runner ? opt.runner : std::make_shared<ThreadPoolRunner>(opt.threads);
+  BatchRunner& runner = *runner_owner;
   report.concurrency = runner.concurrency();
   std::size_t total_cases = 0, done_cases = 0, total_runs = 0, runs_before = 0;
   for (const ReproductionTable& t : tables) {

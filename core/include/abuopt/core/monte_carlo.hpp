@@ -89,6 +89,31 @@ MonteCarloResult run_monte_carlo(const MonteCarloStudy& s, const SampleFunction&
 // Run `index` alone with an injected per-sample function.
 MonteCarloSample run_one(const MonteCarloStudy& s, std::size_t index, const SampleFunction& sample);
 
+// --- Studies run by a runner of their own (other processes) ------------------------------------
+// The inputs of every run (samples[i].index == i, outcome unset) and the runs that are paid for
+// (the others reuse an exchanged run: `reused_from`), exactly as the engine prepares them. A process
+// that rebuilds the study (an MPI rank) gets the same inputs, bit for bit.
+struct PreparedStudy {
+  std::vector<MonteCarloSample> samples;
+  std::vector<std::size_t> simulate;
+};
+PreparedStudy prepare_study(const MonteCarloStudy& s);
+
+// A BatchRunner that runs the simulator's runs of a whole study itself, possibly in other
+// processes (MPI ranks: abuopt::parallel), which rebuild the study from its description: a task
+// closure cannot cross a process boundary. run_monte_carlo(s, runner) below hands such a runner
+// the study instead of tasks.
+class StudyRunner : public BatchRunner {
+ public:
+  // Sets p.samples[k].outcome = Simulator(s.setup).run(beta0, overrides) for every k in
+  // p.simulate (the others are filled by the engine). Progress and exceptions as in run().
+  virtual void run_study(const MonteCarloStudy& s, PreparedStudy& p, const ProgressCallback& progress) = 0;
+};
+
+// The engine for a StudyRunner (validates s).
+MonteCarloResult run_monte_carlo_study(const MonteCarloStudy& s, StudyRunner& runner,
+                                       const ProgressCallback& progress = {});
+
 // --- Simulator-backed defaults ----------------------------------------------------------------
 // These are inline so that the engine's object file has no link-time dependency on the
 // simulator: programs that inject their own SampleFunction link without it.
@@ -102,6 +127,8 @@ inline SampleFunction simulator_sample_function(const SimulationSetup& setup) {
 
 inline MonteCarloResult run_monte_carlo(const MonteCarloStudy& s, BatchRunner& runner,
                                         const ProgressCallback& progress = {}) {
+  if (auto* study_runner = dynamic_cast<StudyRunner*>(&runner))
+    return run_monte_carlo_study(s, *study_runner, progress);
   validate(s);
   return run_monte_carlo(s, simulator_sample_function(s.setup), runner, progress);
 }

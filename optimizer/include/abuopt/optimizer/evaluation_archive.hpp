@@ -147,6 +147,12 @@ class ArchivedProblem : public Problem {
   std::optional<BestKnown> best_known() const override { return inner_.best_known(); }
 
   Evaluation evaluate(const std::vector<double>& x) override;
+  bool thread_safe() const override { return inner_.thread_safe(); }
+  Evaluation evaluate_shared(const std::vector<double>& x, std::size_t concurrent) override;
+  // Hits are answered from the archive; the misses go to the wrapped problem's evaluate_batch and
+  // are stored in input order once all are done (the archive's rows never depend on the threads).
+  std::vector<BatchEvaluation> evaluate_batch(const std::vector<std::vector<double>>& xs,
+                                              EvaluationScheduler& scheduler) override;
 
   long hits() const { return hits_.load(); }      // answered from the archive
   long misses() const { return misses_.load(); }  // evaluated by the wrapped problem and stored

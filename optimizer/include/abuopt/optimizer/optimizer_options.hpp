@@ -6,6 +6,8 @@
 //     algorithm: slsqp            # see docs/optimizers.md or algorithm_names()
 //     max_evaluations: 500
 //     finite_difference: central
+#include <cstddef>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -13,6 +15,8 @@
 #include "abuopt/optimizer/sao_options.hpp"
 
 namespace abuopt::opt {
+
+class EvaluationScheduler;  // evaluation_scheduler.hpp
 
 enum class FiniteDifference { Forward, Central };
 std::string to_string(FiniteDifference kind);  // "forward", "central"
@@ -74,6 +78,15 @@ struct OptimizerOptions {
   bool handle_sigint = true;
   // Keep every evaluation in OptimizationResult::history.
   bool keep_history = true;
+
+  // Evaluation concurrency (evaluation_scheduler.hpp): independent points (a design of
+  // experiments, finite-difference neighbours) are evaluated this many at once when the problem
+  // is thread_safe(); 0: all hardware threads; 1: one after another. Results, history and
+  // archive never depend on it (only wall times do).
+  std::size_t evaluation_threads = 0;
+  // Where batches run instead of threads (e.g. MPI ranks: abuopt::parallel); null: threads as above.
+  // Not a config key.
+  std::shared_ptr<EvaluationScheduler> scheduler;
 
   // Settings of SAO, used when algorithm is SAO (docs/sao.md); ignored otherwise.
   SaoOptions sao;

@@ -25,6 +25,10 @@ class PenaltyProblem : public Problem {
   std::string name() const override { return inner_->name(); }
   std::vector<Variable> variables() const override { return inner_->variables(); }
   Evaluation evaluate(const std::vector<double>& x) override;
+  bool thread_safe() const override { return inner_->thread_safe(); }
+  Evaluation evaluate_shared(const std::vector<double>& x, std::size_t concurrent) override {
+    return penalise(inner_->evaluate_shared(x, concurrent));
+  }
   // The penalty form of an evaluation of the wrapped problem (what evaluate() does after calling
   // it): for values the wrapped problem computed elsewhere, e.g. on a validation sample.
   Evaluation penalise(Evaluation e) const;

@@ -15,6 +15,7 @@
 //
 // The optimiser layer knows nothing of ABUs: metrics are plain named numbers.
 #include <cstddef>
+#include <exception>
 #include <functional>
 #include <map>
 #include <optional>
@@ -22,6 +23,8 @@
 #include <vector>
 
 namespace abuopt::opt {
+
+class EvaluationScheduler;  // evaluation_scheduler.hpp
 
 // One bounded design variable.
 struct Variable {
@@ -47,6 +50,14 @@ struct Evaluation {
   static Evaluation failed(std::string why);
 };
 
+// One point of a batch (Problem::evaluate_batch): its evaluation, or the exception evaluate()
+// threw (then `evaluation` is unset), and the wall time it took.
+struct BatchEvaluation {
+  Evaluation evaluation;
+  std::exception_ptr error;
+  double wall_time_s = 0.0;
+};
+
 // Best known solution of a benchmark problem.
 struct BestKnown {
   std::vector<double> x;
@@ -65,6 +76,21 @@ class Problem {
   // Evaluates the objective, the constraints and the metrics at x (x is inside the bounds and has
   // one entry per variable: every optimiser checks this before calling).
   virtual Evaluation evaluate(const std::vector<double>& x) = 0;
+
+  // ---- Evaluation concurrency (evaluation_scheduler.hpp) ----
+  // True when evaluate() may run on several threads at once (pagmo's thread_safety). Default
+  // false: a batch is evaluated one point after another on the calling thread.
+  virtual bool thread_safe() const { return false; }
+  // evaluate(x) as one of `concurrent` evaluations running at once: a problem with threads of its
+  // own (a Monte Carlo) uses about 1/concurrent of them. Same value as evaluate(x). Default:
+  // evaluate(x).
+  virtual Evaluation evaluate_shared(const std::vector<double>& x, std::size_t concurrent);
+  // Evaluates independent points; out[i] belongs to xs[i] whatever ran where. Every point is
+  // evaluated (an exception of one is stored in its slot, the others go on). Default: on
+  // `scheduler` through evaluate_shared when thread_safe() and there is more than one point, else
+  // evaluate() one after another.
+  virtual std::vector<BatchEvaluation> evaluate_batch(const std::vector<std::vector<double>>& xs,
+                                                      EvaluationScheduler& scheduler);
 
   // Starting point when the caller gives none; default: the middle of the bounds.
   virtual std::vector<double> initial_point() const;
@@ -89,9 +115,12 @@ class FunctionProblem : public Problem {
   Evaluation evaluate(const std::vector<double>& x) override { return function_(x); }
   std::vector<double> initial_point() const override;
   std::optional<BestKnown> best_known() const override { return best_known_; }
+  bool thread_safe() const override { return thread_safe_; }
 
   FunctionProblem& set_initial_point(std::vector<double> x0);
   FunctionProblem& set_best_known(BestKnown best);
+  // Declares the function safe to call from several threads at once (default: not).
+  FunctionProblem& set_thread_safe(bool safe);
 
  private:
   std::string name_;
@@ -101,6 +130,7 @@ class FunctionProblem : public Problem {
   std::vector<std::string> equality_names_;
   std::vector<double> initial_point_;
   std::optional<BestKnown> best_known_;
+  bool thread_safe_ = false;
 };
 
 // ---- The central checks (all throw abuopt::ConfigError with both values in the message) ----

@@ -185,6 +185,17 @@ class StartupProfileProblem : public opt::Problem {
   opt::Evaluation evaluate(const std::vector<double>& x) override;
   std::vector<double> initial_point() const override;
 
+  // Evaluation concurrency (optimizer/evaluation_scheduler.hpp): evaluations are independent and
+  // may run at once, each with its share of the Monte Carlo threads: one of `concurrent` gets
+  // max(1, T / concurrent) of montecarlo.threads = T (0: all cores). With a Monte Carlo runner set
+  // (set_monte_carlo_runner) evaluations go one at a time, each spread by that runner.
+  bool thread_safe() const override { return !runner_; }
+  opt::Evaluation evaluate_shared(const std::vector<double>& x, std::size_t concurrent) override;
+  // Every Monte Carlo of this problem then runs on `runner` (e.g. MPI ranks, abuopt::parallel),
+  // which must outlive the evaluations; null: a ThreadPoolRunner of montecarlo.threads each time.
+  // Results do not depend on it.
+  void set_monte_carlo_runner(std::shared_ptr<BatchRunner> runner) { runner_ = std::move(runner); }
+
   const StartupProfileSettings& settings() const { return settings_; }
 
   // The mapping x -> profile (fixed values from the design). x must have one entry per variable
@@ -221,6 +232,10 @@ class StartupProfileProblem : public opt::Problem {
   };
   std::vector<Slot> slots_;
   std::vector<std::string> constraint_names_;
+  std::shared_ptr<BatchRunner> runner_;
+
+  opt::Evaluation evaluate_with_threads(const StartupProfile& profile, const InitialConditionDesign& design,
+                                        std::size_t runs, std::uint64_t seed, std::size_t threads) const;
 };
 
 }  // namespace abuopt::problems
@@ -230,6 +245,8 @@ namespace abuopt::problems {
 // The problem as the optimisers see it: a StartupProfileProblem, or with
 // constraints.penalty_weight > 0 its exact-L1-penalty form (opt::PenaltyProblem owning it). Throws
 // ConfigError for invalid settings.
-std::unique_ptr<opt::Problem> make_startup_profile_problem(const StartupProfileSettings& settings);
+// `runner`: where its Monte Carlo studies run (StartupProfileProblem::set_monte_carlo_runner).
+std::unique_ptr<opt::Problem> make_startup_profile_problem(const StartupProfileSettings& settings,
+                                                           std::shared_ptr<BatchRunner> runner = nullptr);
 
 }  // namespace abuopt::problems

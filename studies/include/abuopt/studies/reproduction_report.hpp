@@ -3,6 +3,7 @@
 // and plain text) and tables.csv.
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,9 @@ struct PlotNote {
 struct ReproductionOptions {
   std::string out_dir;           // required: everything goes here
   std::size_t threads = 0;       // 0: all cores
+  // Where every case's Monte Carlo runs (e.g. MPI ranks: abuopt::parallel); null: a
+  // ThreadPoolRunner of `threads`. Results do not depend on it.
+  std::shared_ptr<BatchRunner> runner;
   bool plots = true;
   std::string command_line;      // for the report's settings section
   std::string runs_note;         // from override_runs, for the report ("" = report's run counts)

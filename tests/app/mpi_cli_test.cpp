@@ -1,0 +1,255 @@
+// `mpirun -np 2 abuopt ...` against one process (issue 11): the Monte Carlo JSON, the
+// optimisation's result and history, the reproduction's tables and a comparison's runs are identical apart from
+// timing fields; a bad config ends
+// every rank with the message once and exit 2; a rank that throws, or dies, ends the job within
+// 30 s (every faulty command runs under `timeout 30`, the others under `timeout 120`: a hang fails
+// the test instead of stalling CI), and
+// after a death the archive keeps the completed evaluations and a rerun resumes from them.
+// Skipped, with a message, when the build has no MPI (ABUOPT_MPI) or mpirun is missing.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <iostream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Shell {
+  int status;
+  std::string output;
+  double seconds;
+};
+
+Shell shell(const std::string& cmd) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::array<char, 4096> buf{};
+  std::string out;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return {-1, "", 0};
+  while (fgets(buf.data(), buf.size(), p)) out += buf.data();
+  const int st = pclose(p);
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out, s};
+}
+
+#ifdef ABUOPT_MPIEXEC
+const std::string kMpirun = ABUOPT_MPIEXEC;
+#else
+const std::string kMpirun;
+#endif
+
+// mpirun with the flags a container needs (root, more ranks than cores), under a hard bound
+// (`bound` seconds: 30 for the fault tests, the issue's limit; more for the others, which only must
+// not hang, on a loaded machine)
+std::string mpirun(int ranks, const std::string& args, const std::string& env = "", int bound = 120) {
+  static const bool open_mpi = shell(kMpirun + " --version 2>&1").output.find("Open MPI") != std::string::npos;
+  return "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 " + env +
+         " timeout -k 5 " + std::to_string(bound) + " " + kMpirun + (open_mpi ? " --oversubscribe" : "") + " -n " + std::to_string(ranks) +
+         " " + ABUOPT_EXE + " " + args + " 2>&1";
+}
+std::string plain(const std::string& args) { return std::string(ABUOPT_EXE) + " " + args + " 2>&1"; }
+
+#define REQUIRE_MPI()                                                                            \
+  do {                                                                                           \
+    if (kMpirun.empty()) GTEST_SKIP() << "built without MPI (ABUOPT_MPI=OFF or MPI not found)"; \
+  } while (0)
+
+const std::string kFinal = std::string(ABUOPT_SOURCE_DIR) + "/configs/montecarlo_final_profile.yaml";
+const std::string kQuick = std::string(ABUOPT_SOURCE_DIR) + "/configs/optimize/quick.yaml";
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::path(ABUOPT_BINARY_DIR) / "mpi_cli_test" / name;
+  fs::remove_all(d);
+  fs::create_directories(d.parent_path());
+  return d;
+}
+
+// JSON without timing fields and without where it was written
+nlohmann::json strip(nlohmann::json j) {
+  if (j.is_object()) {
+    nlohmann::json o = nlohmann::json::object();
+    for (auto& [k, v] : j.items())
+      if (k.find("wall_time") == std::string::npos && k != "elapsed_s" && k != "out" && k != "files" &&
+          k != "archive" && k != "convergence_plot" && k.find("mc_wall") == std::string::npos)
+        o[k] = strip(v);
+    return o;
+  }
+  if (j.is_array())
+    for (auto& v : j) v = strip(v);
+  return j;
+}
+
+nlohmann::json read_json(const fs::path& p) {
+  std::ifstream f(p);
+  return nlohmann::json::parse(f);
+}
+
+// history.csv without its timing columns
+std::string history_without_timing(const fs::path& p) {
+  std::ifstream f(p);
+  std::string line, out;
+  std::vector<bool> keep;
+  while (std::getline(f, line)) {
+    std::vector<std::string> cells;
+    std::string cell;
+    for (char c : line) {
+      if (c == ',') {
+        cells.push_back(cell);
+        cell.clear();
+      } else {
+        cell += c;
+      }
+    }
+    cells.push_back(cell);
+    if (keep.empty())
+      for (const auto& h : cells) keep.push_back(h.find("wall_time") == std::string::npos && h != "elapsed_s");
+    for (std::size_t i = 0; i < cells.size(); ++i)
+      if (i < keep.size() && keep[i]) out += cells[i] + ",";
+    out += "\n";
+  }
+  return out;
+}
+
+TEST(MpiCli, MonteCarloOverTwoRanksIsIdenticalToOneProcess) {
+  REQUIRE_MPI();
+  const std::string args = "montecarlo " + kFinal + " --design random --runs 96 --seed 5 --json";
+  // the same concurrency (2) either way, so even the `concurrency` field agrees
+  const Shell one = shell(plain(args + " --threads 2"));
+  ASSERT_EQ(one.status, 0) << one.output;
+  const Shell two = shell(mpirun(2, args + " --threads 1"));
+  ASSERT_EQ(two.status, 0) << two.output;
+  const auto a = strip(nlohmann::json::parse(one.output)), b = strip(nlohmann::json::parse(two.output));
+  EXPECT_EQ(a, b) << "one process:\n" << one.output << "\ntwo ranks:\n" << two.output;
+  EXPECT_EQ(a["runs"], 96);
+  // two threads in each of two ranks: every field but the concurrency
+  const Shell four = shell(mpirun(2, args + " --threads 2"));
+  ASSERT_EQ(four.status, 0) << four.output;
+  auto c = strip(nlohmann::json::parse(four.output));
+  EXPECT_EQ(c["concurrency"], 4);
+  c["concurrency"] = 2;
+  EXPECT_EQ(a, c);
+}
+
+TEST(MpiCli, OptimizeOverTwoRanksIsIdenticalToOneProcess) {
+  REQUIRE_MPI();
+  const fs::path d1 = fresh_dir("opt1"), d2 = fresh_dir("opt2");
+  const Shell one = shell(plain("optimize " + kQuick + " --out " + d1.string()));
+  ASSERT_EQ(one.status, 0) << one.output;
+  const Shell two = shell(mpirun(2, "optimize " + kQuick + " --out " + d2.string()));
+  ASSERT_EQ(two.status, 0) << two.output;
+  EXPECT_EQ(strip(read_json(d1 / "result.json")), strip(read_json(d2 / "result.json")));
+  EXPECT_EQ(history_without_timing(d1 / "history.csv"), history_without_timing(d2 / "history.csv"));
+  EXPECT_GT(history_without_timing(d2 / "history.csv").size(), 200u);
+}
+
+TEST(MpiCli, ReproduceOverTwoRanksIsIdenticalToOneProcess) {
+  REQUIRE_MPI();
+  const fs::path d1 = fresh_dir("rep1"), d2 = fresh_dir("rep2");
+  const std::string args = "reproduce --only final --runs 64 --out ";
+  const Shell one = shell(plain(args + d1.string() + " --threads 2"));
+  ASSERT_EQ(one.status, 0) << one.output;
+  const Shell two = shell(mpirun(2, args + d2.string() + " --threads 1"));
+  ASSERT_EQ(two.status, 0) << two.output;
+  auto text = [](const fs::path& p) {
+    std::ifstream f(p);
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  };
+  EXPECT_EQ(history_without_timing(d1 / "tables.csv"), history_without_timing(d2 / "tables.csv"));
+  EXPECT_GT(text(d2 / "tables.csv").size(), 100u);
+  // the per-run CSV without its wall-time column
+  EXPECT_EQ(history_without_timing(d1 / "runs" / "final" / "final.csv"),
+            history_without_timing(d2 / "runs" / "final" / "final.csv"));
+}
+
+TEST(MpiCli, CompareOverTwoRanksIsIdenticalToOneProcess) {
+  REQUIRE_MPI();
+  const fs::path cfg = fs::path(ABUOPT_BINARY_DIR) / "mpi_cli_test" / "compare_small.yaml";
+  fs::create_directories(cfg.parent_path());
+  std::ofstream(cfg) << R"(
+problems:
+  - label: startup_profile
+    max_evaluations: 6
+    starts: 2
+    seed: 1
+    startup_profile:
+      montecarlo: {design: lhs, runs: 16, seed: 11}
+      design:
+        segments:
+          - end_frequency_hz: {min: 15, max: 28, x0: 25}
+            duration_s: {min: 0.3, max: 3, x0: 1}
+          - end_frequency_hz: {min: 28, max: 32, x0: 29.5}
+            duration_s: {min: 1, max: 12, x0: 10}
+          - end_frequency_hz: 100
+            duration_s: {min: 1, max: 10, x0: 8}
+      constraints: {max_startup_time_s: 20, max_pct_mi: 50}
+solvers:
+  - {label: COBYLA, algorithm: cobyla}
+  - {label: SAO, algorithm: sao}
+)";
+  const fs::path d1 = fresh_dir("cmp1"), d2 = fresh_dir("cmp2");
+  const Shell one = shell(plain("compare " + cfg.string() + " --out " + d1.string()));
+  ASSERT_EQ(one.status, 0) << one.output;
+  const Shell two = shell(mpirun(2, "compare " + cfg.string() + " --out " + d2.string()));
+  ASSERT_EQ(two.status, 0) << two.output;
+  EXPECT_EQ(history_without_timing(d1 / "runs.csv"), history_without_timing(d2 / "runs.csv"));
+  EXPECT_EQ(history_without_timing(d1 / "convergence.csv"), history_without_timing(d2 / "convergence.csv"));
+  EXPECT_GT(history_without_timing(d2 / "runs.csv").size(), 100u);
+}
+
+TEST(MpiCli, ABadConfigEndsEveryRankWithTheMessageOnce) {
+  REQUIRE_MPI();
+  const Shell r = shell(mpirun(2, "montecarlo " + kFinal + " --runs 0", "", 30));
+  EXPECT_EQ(r.status, 2) << r.output;
+  std::size_t count = 0;
+  for (std::size_t at = r.output.find("abuopt: error:"); at != std::string::npos;
+       at = r.output.find("abuopt: error:", at + 1))
+    ++count;
+  EXPECT_EQ(count, 1u) << r.output;
+  EXPECT_NE(r.output.find("--runs = 0"), std::string::npos) << r.output;
+  EXPECT_LT(r.seconds, 30);
+}
+
+TEST(MpiCli, AnExceptionOnAServingRankEndsTheJobWithItsMessage) {
+  REQUIRE_MPI();
+  const Shell r = shell(mpirun(2, "montecarlo " + kFinal + " --design random --runs 64 --threads 1",
+                             "ABUOPT_TEST_FAULT=throw:1", 30));
+  EXPECT_EQ(r.status, 3) << r.output;  // the computation failed
+  EXPECT_NE(r.output.find("rank 1: fault injected"), std::string::npos) << r.output;
+  std::cout << "[output of the fault]\n" << r.output;
+  EXPECT_LT(r.seconds, 30) << r.output;
+}
+
+TEST(MpiCli, ADyingRankEndsTheJobAndTheArchiveResumes) {
+  REQUIRE_MPI();
+  const fs::path d = fresh_dir("die");
+  // rank 1 dies in its 12th chunk of runs (a few evaluations in)
+  const Shell r = shell(mpirun(2, "optimize " + kQuick + " --out " + d.string(), "ABUOPT_TEST_FAULT=die:1:12", 30));
+  EXPECT_NE(r.status, 0) << r.output;
+  EXPECT_NE(r.status, 124) << "timed out: " << r.output;  // `timeout` ended a hang
+  EXPECT_LT(r.seconds, 30) << r.output;
+  EXPECT_NE(r.output.find("eval    2"), std::string::npos) << r.output;  // some evaluations were done
+  EXPECT_EQ(r.output.find("eval   10"), std::string::npos) << r.output;  // and not all
+  // a rerun without the fault answers the completed evaluations from the archive and finishes
+  const Shell again = shell(mpirun(2, "optimize " + kQuick + " --out " + d.string()));
+  ASSERT_EQ(again.status, 0) << again.output;
+  EXPECT_NE(again.output.find("(resuming"), std::string::npos) << again.output;
+  EXPECT_NE(again.output.find("[archive]"), std::string::npos) << again.output;
+  const nlohmann::json j = read_json(d / "result.json");
+  EXPECT_GE(j["archive_hits"].get<long>(), 2) << again.output;
+  // the same best design as one uninterrupted process
+  const fs::path clean = fresh_dir("die_clean");
+  ASSERT_EQ(shell(plain("optimize " + kQuick + " --out " + clean.string())).status, 0);
+  EXPECT_EQ(strip(j["best"]), strip(read_json(clean / "result.json")["best"]));
+}
+
+}  // namespace
