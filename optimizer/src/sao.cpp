@@ -72,6 +72,7 @@ void SaoRun::run(const std::vector<double>& x0) {
   centre_z_ = known_[centre_].z;
   mu_ = sao_.penalty_initial > 0 ? sao_.penalty_initial
                                  : 10.0 * std::max(1.0, known_[centre_].ok ? std::fabs(known_[centre_].f) : 1.0);
+  if (sao_.global_phase.points > 0 && !global_phase()) return;
 
   int stalled = 0;
   while (true) {

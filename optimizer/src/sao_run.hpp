@@ -2,7 +2,8 @@
 // Internal: the state and steps of one SAO run (sao.hpp describes the algorithm). The steps live
 // in their own files: sao.cpp (the iteration loop, the ratio test, points), sao_design.cpp (the
 // points of a region), sao_models.cpp (the surrogates), sao_subproblem.cpp (the sub-problem and the
-// penalty), sao_noise.cpp (the noise estimate of the ratio test).
+// penalty), sao_noise.cpp (the noise estimate of the ratio test), sao_global.cpp (the optional
+// global phase before the trust region).
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -158,6 +159,11 @@ class SaoRun {
   Eigen::VectorXd run_nlopt(const Models& models, bool feasibility_phase, const Eigen::VectorXd& start,
                             const RegionBox& box) const;
   void update_penalty(const Models& models, const Eigen::VectorXd& s);
+
+  // ---- global phase (sao_global.cpp) ----
+  // Space-filling design and constrained-expected-improvement infill over the whole box, then the
+  // centre moves to the known point of lowest merit. false: stopped.
+  bool global_phase();
 
   // ---- noise (sao_noise.cpp does the arithmetic) ----
   double merit_noise(const Models& models, bool phase1) const;
