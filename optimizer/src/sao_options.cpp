@@ -179,6 +179,7 @@ void describe_fields(FieldArchive& a, SaoOptions& o) {
   a.field("correction", o.correction);
   a.field("short_step", o.short_step);
   a.field("noise_tolerance", o.noise_tolerance);
+  a.field("noise_detection", o.noise_detection);
   a.field("penalty_initial", o.penalty_initial);
   a.field("penalty_multiplier_factor", o.penalty_multiplier_factor);
   a.field("stall_iterations", o.stall_iterations, Rule::in_range(1, 1e6));

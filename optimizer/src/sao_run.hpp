@@ -3,7 +3,7 @@
 // in their own files: sao.cpp (the iteration loop, the ratio test, points), sao_design.cpp (the
 // points of a region), sao_models.cpp (the surrogates), sao_subproblem.cpp (the sub-problem and the
 // penalty), sao_noise.cpp (the noise estimate of the ratio test), sao_global.cpp (the optional
-// global phase before the trust region).
+// global phase before the trust region), sao_noise_probe.cpp (noise detected from the data).
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -26,6 +26,9 @@
 namespace abuopt::opt::detail {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Once noise is detected from the data, designs per region hold this many times the automatic
+// point count (least squares over about twice the terms, as doe_points_factor 2 by hand).
+constexpr double kNoisyPointsFactor = 2.0;
 
 // One known point (evaluated in this run, or taken from an archive).
 struct KnownPoint {
@@ -35,6 +38,10 @@ struct KnownPoint {
   bool ok = false;
   double l1_violation = kInf;  // sum max(0, g) + sum |h|
   double runs = 0;             // the evaluation's metric "runs" (Monte Carlo runs), 0 without it
+  // a point of a noise probe that found no noise: it stays known (never evaluated again) but does
+  // not enter the fits, so that a probe on a smooth problem changes nothing but the count
+  bool probe_only = false;
+  bool fits() const { return ok && !probe_only; }
 };
 
 // The surrogates of one iteration, in local coordinates s, each plus an additive offset (the
@@ -167,6 +174,11 @@ class SaoRun {
 
   // ---- noise (sao_noise.cpp does the arithmetic) ----
   double merit_noise(const Models& models, bool phase1) const;
+  // The noise probe after a failed step (sao_noise.cpp, docs/sao.md "Noise detected from the
+  // data"): two evaluations on a short segment from the centre; true when the second difference of
+  // the responses says the merit's noise is comparable to the predicted reduction; nullopt once
+  // the run is stopped.
+  std::optional<bool> probe_noise(double predicted, bool phase1);
 
   const OptimizerOptions& options_;
   const SaoOptions& sao_;
@@ -187,6 +199,10 @@ class SaoRun {
   std::vector<InterveningChoice> last_choice_;
   // which residual noise levels are noise, not lack of fit
   NoiseConfirmation noise_confirmation_;
+  // noise detected from the data (probe_noise): designs per region with twice the points
+  bool noisy_ = false;
+  double last_probe_radius_ = kInf;
+  std::vector<double> probed_noise_;  // per response, set when the probe finds noise
 };
 
 }  // namespace abuopt::opt::detail
