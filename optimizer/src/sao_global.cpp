@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <optional>
 #include <random>
 
@@ -28,7 +29,7 @@ constexpr double kEqualityBand = 0.05;
 constexpr double kTiny = 1e-300;
 
 double normal_cdf(double u) { return 0.5 * std::erfc(-u / std::sqrt(2.0)); }
-double normal_pdf(double u) { return std::exp(-0.5 * u * u) / std::sqrt(2.0 * M_PI); }
+double normal_pdf(double u) { return std::exp(-0.5 * u * u) / std::sqrt(2.0 * std::numbers::pi); }
 
 // Expected improvement below `best` of a normal prediction (mean, sd):
 //   EI = (best - mean) Phi(u) + sd phi(u),  u = (best - mean) / sd;  max(0, best - mean) at sd = 0.
@@ -51,7 +52,6 @@ double probability_between(double mean, double sd, double lo, double hi) {
 struct Acquisition {
   std::vector<surrogate::Kriging> models;  // objective, inequalities, equalities
   std::vector<double> lo, hi;               // feasible interval of every constraint
-  std::size_t m_ineq = 0;
   bool has_incumbent = false;
   double best = 0;  // the lowest objective among the feasible points (has_incumbent)
 
@@ -97,7 +97,6 @@ bool SaoRun::global_phase() {
     Eigen::MatrixXd X(m, n_);
     for (int i = 0; i < m; ++i) X.row(i) = pts[i]->z.transpose();
     Acquisition acq;
-    acq.m_ineq = m_ineq_;
     const std::size_t responses = 1 + m_ineq_ + m_eq_;
     auto value = [&](const KnownPoint& p, std::size_t k) {
       return k == 0 ? p.f : k <= m_ineq_ ? p.g[k - 1] : p.h[k - 1 - m_ineq_];

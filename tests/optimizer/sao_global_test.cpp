@@ -164,7 +164,8 @@ TEST(SaoNoiseDetection, SmoothBenchmarksKeepTheirEvaluationCounts) {
     off.noise_detection = false;
     const long with = evaluations_to_one_percent(opt::minimize_sao(*p1, o, opt::SaoOptions{}), f_star);
     const long without = evaluations_to_one_percent(opt::minimize_sao(*p2, o, off), f_star);
-    std::cout << "[measure] " << name << ": evaluations to 1% with detection " << with << ", without " << without << "\n";
+    std::cout << "[measure] " << name << ": evaluations to 1% with detection " << with << ", without " << without
+              << "\n";
     EXPECT_EQ(with, expected) << name;
     EXPECT_EQ(without, expected) << name;
   }
