@@ -174,9 +174,9 @@ class SaoRun {
 
   // ---- noise (sao_noise.cpp does the arithmetic) ----
   double merit_noise(const Models& models, bool phase1) const;
-  // The noise probe after a failed step (sao_noise.cpp, docs/sao.md "Noise detected from the
-  // data"): two evaluations on a short segment from the centre; true when the second difference of
-  // the responses says the merit's noise is comparable to the predicted reduction; nullopt once
+  // The noise probe after two failed steps in a row (sao_noise_probe.cpp, docs/sao.md "Noise
+  // detected from the data"): four evaluations on a short segment from the centre; true when the
+  // second differences of the responses say the merit's noise is comparable to the predicted reduction; nullopt once
   // the run is stopped.
   std::optional<bool> probe_noise(double predicted, bool phase1);
 

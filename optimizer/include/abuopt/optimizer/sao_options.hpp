@@ -122,9 +122,9 @@ struct SaoOptions {
   // shortfall (predicted - actual) is at most kappa * sigma does not either. 0: off (the classical
   // ratio test). In [0, 100].
   double noise_tolerance = 1.0;
-  // Noise detected from the data (docs/sao.md): after a failed step the centre's neighbourhood is
-  // probed by two evaluations; if their second difference says the noise is comparable with the
-  // predicted reduction, the run switches to regression designs (twice the automatic point count,
+  // Noise detected from the data (docs/sao.md): after two failed steps in a row the centre's
+  // neighbourhood is probed by four evaluations on a segment; if their second differences at two
+  // step lengths say the noise is comparable with the predicted reduction, the run switches to regression designs (twice the automatic point count,
   // as doe_points_factor 2) and to a maximum-likelihood nugget for kriging. false: never.
   bool noise_detection = true;
 
