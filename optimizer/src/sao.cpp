@@ -72,8 +72,11 @@ void SaoRun::run(const std::vector<double>& x0) {
   centre_z_ = known_[centre_].z;
   mu_ = sao_.penalty_initial > 0 ? sao_.penalty_initial
                                  : 10.0 * std::max(1.0, known_[centre_].ok ? std::fabs(known_[centre_].f) : 1.0);
+  if (sao_.global_phase.points > 0 && !global_phase()) return;
 
   int stalled = 0;
+  int failures_in_a_row = 0;  // steps rejected or with rho <= rho_shrink
+  double streak_radius = radius_;  // the radius before the first of them
   while (true) {
     if (radius_ < sao_.min_radius) {
       reason = TerminationReason::ConvergedXtol;
@@ -120,6 +123,10 @@ void SaoRun::run(const std::vector<double>& x0) {
     }
     record.surrogate = models->basis;
     noise_confirmation_.confirm(models->noise, models->noise_fraction, radius_);
+    // noise measured by the probe holds whatever the fit says (the residuals of a fit that
+    // interpolates, or of too few points, say nothing)
+    for (std::size_t k = 0; k < probed_noise_.size() && k < models->noise.size(); ++k)
+      models->noise[k] = std::max(models->noise[k], probed_noise_[k]);
     bool phase1 = false;
     const Eigen::VectorXd s = solve_subproblem(*models, phase1);
     feasibility_phase_ = phase1;
@@ -162,12 +169,29 @@ void SaoRun::run(const std::vector<double>& x0) {
     // a new design whose merit is exactly the centre's: the response is flat (quantised,
     // piecewise constant) at this scale, and a smaller region would only see more of the same
     const bool flat = actual == 0 && !repeated;
-    const bool within_noise = (predicted <= sigma || flat) && !repeated;
+    bool within_noise = (predicted <= sigma || flat) && !repeated;
+    // Noise detected from the data (docs/sao.md): the second failed step in a row, at a radius at
+    // least 16 times smaller than the last probe's (the first: any), is checked by the probe
+    // (sao_noise_probe.cpp); if noise explains it, the run switches to regression designs (as
+    // doe_points_factor 2) and the radius returns to its value before the streak of failures.
+    const bool failed = !(actual > 0) || rho <= sao_.rho_shrink;
+    if (failed && failures_in_a_row == 0) streak_radius = radius_;
+    failures_in_a_row = failed ? failures_in_a_row + 1 : 0;
+    if (!noisy_ && sao_.noise_detection && !repeated && failures_in_a_row >= 2 &&
+        radius_ <= last_probe_radius_ / 16) {
+      const std::optional<bool> noise = probe_noise(predicted, phase1);
+      if (!noise) return;
+      if (*noise) {  // the failures of the streak were noise: their shrinks are undone
+        noisy_ = true;
+        within_noise = true;
+        radius_ = std::max(radius_, streak_radius);
+      }
+    }
     if (!(actual > 0)) {
       if (!within_noise) radius_ *= sao_.shrink_factor;  // rejected: keep the centre
     } else {
       if (rho <= sao_.rho_shrink) {
-        if (predicted - actual > sigma) radius_ *= sao_.shrink_factor;
+        if (predicted - actual > sigma && !within_noise) radius_ *= sao_.shrink_factor;
       }
       else if (rho >= sao_.rho_expand_low && rho <= sao_.rho_expand_high && on_boundary)
         radius_ = std::min(sao_.max_radius, radius_ * sao_.expand_factor);

@@ -26,15 +26,16 @@ int SaoRun::wanted_points(SurrogateKind basis) const {
   if (basis == SurrogateKind::Linear) count = n_ + 1;
   if (basis == SurrogateKind::Interactions) count = surrogate::terms_count(Basis::kInteractions, n_);
   if (basis == SurrogateKind::Quadratic) count = surrogate::terms_count(Basis::kQuadratic, n_);
-  return static_cast<int>(std::ceil(sao_.doe_points_factor * count));
+  const double factor = noisy_ ? std::max(sao_.doe_points_factor, kNoisyPointsFactor) : sao_.doe_points_factor;
+  return static_cast<int>(std::ceil(factor * count));
 }
 
-// The default (doe auto, no explicit point count, no factor, response surfaces): no fresh design
+// The default (doe auto, no explicit point count, no factor, response surfaces, no noise detected): no fresh design
 // per region; every evaluated point joins the fit and a point is added only where the geometry of
 // the fit zone is poor (repair_geometry).
 bool SaoRun::minimal_design() const {
   return sao_.doe == DoeKind::Auto && sao_.doe_points == 0 && sao_.doe_points_factor == 1.0 &&
-         sao_.surrogate != SurrogateKind::Kriging;
+         sao_.surrogate != SurrogateKind::Kriging && !noisy_;
 }
 
 // Adds points until the ok points of the fit zone (|s|_inf <= neighbourhood, weights as in fit())
@@ -57,7 +58,7 @@ bool SaoRun::repair_geometry() {
       const Eigen::VectorXd sp = to_s(p.z);
       const double d = sp.cwiseAbs().maxCoeff();
       if (d <= sao_.neighbourhood * (1 + 1e-9)) occupied.push_back(sp);
-      if (!p.ok || d > sao_.neighbourhood * (1 + 1e-9)) continue;
+      if (!p.fits() || d > sao_.neighbourhood * (1 + 1e-9)) continue;
       const double w = d <= 1 + 1e-9 ? 1.0 : 1.0 / std::pow(d, 4);
       zone.emplace_back(sp, w);
       mean += w * sp;
@@ -103,7 +104,7 @@ bool SaoRun::fill_region(SurrogateKind basis) {
   for (const KnownPoint& p : known_)
     if (in_region(p.z)) {
       occupied.push_back(to_s(p.z));
-      if (p.ok) ++count;
+      if (p.fits()) ++count;
     }
 
   DoeKind doe = sao_.doe;
@@ -201,7 +202,7 @@ bool SaoRun::fill_region(SurrogateKind basis) {
   auto rank = [&] {
     std::vector<Eigen::VectorXd> rows;
     for (const KnownPoint& p : known_)
-      if (p.ok && in_region(p.z)) rows.push_back(to_s(p.z));
+      if (p.fits() && in_region(p.z)) rows.push_back(to_s(p.z));
     if (rows.empty()) return Eigen::Index{0};
     Eigen::MatrixXd a(rows.size(), n_ + 1);
     for (std::size_t r = 0; r < rows.size(); ++r) {

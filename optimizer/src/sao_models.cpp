@@ -14,6 +14,10 @@ std::unique_ptr<surrogate::Surrogate> SaoRun::make_model(SurrogateKind basis) co
   if (basis == SurrogateKind::Kriging) {
     surrogate::KrigingOptions k;
     k.nugget = sao_.kriging_nugget;
+    if (noisy_) {  // noise detected: the likelihood chooses the nugget, kriging_nugget its floor
+      k.estimate_nugget = true;
+      k.max_nugget = std::max(1.0, 10 * sao_.kriging_nugget);
+    }
     k.starts = 2;
     k.max_evaluations = 200;
     return surrogate::make_surrogate("kriging", &k);
@@ -28,7 +32,7 @@ std::optional<Models> SaoRun::fit(SurrogateKind requested) {
   std::vector<double> w;
   std::vector<const KnownPoint*> pts;
   for (const KnownPoint& p : known_) {
-    if (!p.ok) continue;
+    if (!p.fits()) continue;
     const Eigen::VectorXd sp = to_s(p.z);
     const double d = sp.cwiseAbs().maxCoeff();
     if (d > sao_.neighbourhood * (1 + 1e-9)) continue;

@@ -118,6 +118,10 @@ void SaoOptions::validate(const std::string& p) const {
           "must be >= 10");
   require(std::isfinite(kriging_nugget) && kriging_nugget > 0 && kriging_nugget < 1, p, "kriging_nugget",
           kriging_nugget, "must be in (0, 1)");
+  require(global_phase.points == 0 || global_phase.points >= 2, p + ".global_phase", "points", global_phase.points,
+          "must be 0 (no global phase) or >= 2");
+  require(global_phase.iterations == 0 || global_phase.points > 0, p + ".global_phase", "iterations",
+          global_phase.iterations, "needs global_phase.points > 0 (the design the infill starts from)");
   if (surrogate == SurrogateKind::Quadratic && doe == DoeKind::Koshal)
     throw ConfigError(p + ".doe", to_string(doe), "koshal (n+1 points) cannot determine a quadratic surrogate; use auto, axial, "
                                        "central_composite or lhs");
@@ -175,6 +179,7 @@ void describe_fields(FieldArchive& a, SaoOptions& o) {
   a.field("correction", o.correction);
   a.field("short_step", o.short_step);
   a.field("noise_tolerance", o.noise_tolerance);
+  a.field("noise_detection", o.noise_detection);
   a.field("penalty_initial", o.penalty_initial);
   a.field("penalty_multiplier_factor", o.penalty_multiplier_factor);
   a.field("stall_iterations", o.stall_iterations, Rule::in_range(1, 1e6));
@@ -182,6 +187,12 @@ void describe_fields(FieldArchive& a, SaoOptions& o) {
   a.field("subproblem_solver", o.subproblem_solver, solvers);
   a.field("subproblem_max_evaluations", o.subproblem_max_evaluations, Rule::in_range(10, 1e7));
   a.field("kriging_nugget", o.kriging_nugget);
+  a.nested("global_phase", o.global_phase);
+}
+
+void describe_fields(FieldArchive& a, SaoGlobalPhase& o) {
+  a.field("points", o.points, Rule::in_range(0, 100000));
+  a.field("iterations", o.iterations, Rule::in_range(0, 100000));
 }
 
 SaoOptions read_sao_options(YamlReader& r) {

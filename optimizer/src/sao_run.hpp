@@ -2,7 +2,8 @@
 // Internal: the state and steps of one SAO run (sao.hpp describes the algorithm). The steps live
 // in their own files: sao.cpp (the iteration loop, the ratio test, points), sao_design.cpp (the
 // points of a region), sao_models.cpp (the surrogates), sao_subproblem.cpp (the sub-problem and the
-// penalty), sao_noise.cpp (the noise estimate of the ratio test).
+// penalty), sao_noise.cpp (the noise estimate of the ratio test), sao_global.cpp (the optional
+// global phase before the trust region), sao_noise_probe.cpp (noise detected from the data).
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -25,6 +26,9 @@
 namespace abuopt::opt::detail {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Once noise is detected from the data, designs per region hold this many times the automatic
+// point count (least squares over about twice the terms, as doe_points_factor 2 by hand).
+constexpr double kNoisyPointsFactor = 2.0;
 
 // One known point (evaluated in this run, or taken from an archive).
 struct KnownPoint {
@@ -34,6 +38,10 @@ struct KnownPoint {
   bool ok = false;
   double l1_violation = kInf;  // sum max(0, g) + sum |h|
   double runs = 0;             // the evaluation's metric "runs" (Monte Carlo runs), 0 without it
+  // a point of a noise probe that found no noise: it stays known (never evaluated again) but does
+  // not enter the fits, so that a probe on a smooth problem changes nothing but the count
+  bool probe_only = false;
+  bool fits() const { return ok && !probe_only; }
 };
 
 // The surrogates of one iteration, in local coordinates s, each plus an additive offset (the
@@ -159,8 +167,18 @@ class SaoRun {
                             const RegionBox& box) const;
   void update_penalty(const Models& models, const Eigen::VectorXd& s);
 
+  // ---- global phase (sao_global.cpp) ----
+  // Space-filling design and constrained-expected-improvement infill over the whole box, then the
+  // centre moves to the known point of lowest merit. false: stopped.
+  bool global_phase();
+
   // ---- noise (sao_noise.cpp does the arithmetic) ----
   double merit_noise(const Models& models, bool phase1) const;
+  // The noise probe after two failed steps in a row (sao_noise_probe.cpp, docs/sao.md "Noise
+  // detected from the data"): four evaluations on a short segment from the centre; true when the
+  // second differences of the responses say the merit's noise is comparable to the predicted reduction; nullopt once
+  // the run is stopped.
+  std::optional<bool> probe_noise(double predicted, bool phase1);
 
   const OptimizerOptions& options_;
   const SaoOptions& sao_;
@@ -181,6 +199,10 @@ class SaoRun {
   std::vector<InterveningChoice> last_choice_;
   // which residual noise levels are noise, not lack of fit
   NoiseConfirmation noise_confirmation_;
+  // noise detected from the data (probe_noise): designs per region with twice the points
+  bool noisy_ = false;
+  double last_probe_radius_ = kInf;
+  std::vector<double> probed_noise_;  // per response, set when the probe finds noise
 };
 
 }  // namespace abuopt::opt::detail

@@ -121,7 +121,7 @@ Eigen::VectorXd SaoRun::solve_subproblem(Models& models, bool& feasibility_phase
     double best = merit(known_[centre_]);
     std::optional<Eigen::VectorXd> s_best;
     for (const KnownPoint& p : known_)
-      if (p.ok && in_region(p.z) && merit(p) < best) {
+      if (p.fits() && in_region(p.z) && merit(p) < best) {
         best = merit(p);
         s_best = to_s(p.z);
       }

@@ -40,6 +40,18 @@ const std::vector<std::string>& doe_kind_names();
 const std::vector<std::string>& intervening_kind_names();
 const std::vector<std::string>& subproblem_solver_names();
 
+// SAO's optional global phase (docs/sao.md, "Global phase"): before the local trust region, a
+// space-filling design over the whole box (a maximin Latin hypercube of `points` points besides
+// the start), then `iterations` infill points, each where the constrained expected improvement of
+// kriging models of the objective and of every constraint is largest; the trust region then starts
+// from the best point found (lowest exact-penalty merit). points 0: no global phase.
+//
+//   sao: {global_phase: {points: 20, iterations: 20}}
+struct SaoGlobalPhase {
+  int points = 0;      // 0 (off) or >= 2
+  int iterations = 0;  // >= 0; needs points > 0
+};
+
 struct SaoOptions {
   // Surrogate of the objective and of every constraint: auto, linear, interactions,
   // pure_quadratic, quadratic, kriging. auto: the richest of quadratic > pure_quadratic > linear
@@ -110,6 +122,11 @@ struct SaoOptions {
   // shortfall (predicted - actual) is at most kappa * sigma does not either. 0: off (the classical
   // ratio test). In [0, 100].
   double noise_tolerance = 1.0;
+  // Noise detected from the data (docs/sao.md): after two failed steps in a row the centre's
+  // neighbourhood is probed by four evaluations on a segment; if their second differences at two
+  // step lengths say the noise is comparable with the predicted reduction, the run switches to regression designs (twice the automatic point count,
+  // as doe_points_factor 2) and to a maximum-likelihood nugget for kriging. false: never.
+  bool noise_detection = true;
 
   // Initial exact-penalty weight mu; 0: automatic, 10 max(1, |f(x0)|).
   double penalty_initial = 0.0;
@@ -127,6 +144,9 @@ struct SaoOptions {
   // Kriging nugget (relative to the process variance); raise it (e.g. 1e-2) for noisy problems.
   double kriging_nugget = 1e-8;
 
+  // Space-filling design and expected-improvement infill before the trust region (off by default).
+  SaoGlobalPhase global_phase;
+
   // Points of this archive (same problem id) inform the surrogates without being evaluated
   // again. Not read from YAML; not owned; may be null.
   const EvaluationArchive* archive = nullptr;
@@ -139,6 +159,7 @@ struct SaoOptions {
 // The one field list of the `sao:` section (config_fields.hpp): reading, writing and the single-
 // value rules come from it; validate() adds the rules that relate keys.
 void describe_fields(FieldArchive& a, SaoOptions& o);
+void describe_fields(FieldArchive& a, SaoGlobalPhase& o);
 
 // Reads the keys of a `sao:` section (pass root.child("sao")); absent keys keep their defaults,
 // unknown keys are errors (finish() is called), then validate().

@@ -1,0 +1,79 @@
+// SAO: noise detected from the data (docs/sao.md, "Noise detected from the data"). A replicate-free
+// probe: with common random numbers (or any deterministic noise) evaluating a point again gives
+// the same value, so the noise is read from second differences on a short segment instead.
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "sao_run.hpp"
+
+namespace abuopt::opt::detail {
+
+namespace {
+
+// The probe's longer step as a fraction of the radius (d = 0.1 r; the shorter one is d / 4).
+constexpr double kProbeStep = 0.1;
+// Noise counts when kProbeRatio times the merit's noise level reaches the predicted reduction.
+constexpr double kProbeRatio = 20.0;
+// A noise level below this fraction of max(1, |y|) is rounding error of a smooth response.
+constexpr double kRounding = 1e-9;
+
+}  // namespace
+
+// Second differences D(d) = y(c + 2 d v) - 2 y(c + d v) + y(c) of every response, at d = 0.1 r
+// and at d / 4 (four evaluations; v a seeded sign vector kept inside the box). On a smooth response
+// D(d) = y''_v d^2 + O(d^3): at most 1/100 of the curvature term over the region, and D(d / 4) is
+// 1/16 of D(d). On a response with independent noise of standard deviation sigma,
+// Var D = (1 + 4 + 1) sigma^2 at both steps: |D| / sqrt(6) estimates sigma, and the two are alike
+// (|D(d/4)| >= |D(d)| / 4 with probability 1 - (2/pi) atan(1/4) = 0.84). A response is noisy at
+// this scale when |D(d/4)| >= |D(d)| / 4; its noise level is then (|D(d)| + |D(d/4)|) / (2 sqrt 6),
+// else 0. The merit's noise is combined from them as the ratio test does (merit_noise); noise is
+// declared when kProbeRatio * sigma_merit >= the predicted reduction that failed.
+std::optional<bool> SaoRun::probe_noise(double predicted, bool phase1) {
+  const KnownPoint c = known_[centre_];  // a copy: evaluate() may grow known_
+  if (!c.ok) return false;
+  last_probe_radius_ = radius_;
+  std::mt19937_64 rng(options_.seed * 6364136223846793005ULL + static_cast<std::uint64_t>(iterations));
+  const double d = kProbeStep * radius_;
+  Eigen::VectorXd v(n_);
+  for (int i = 0; i < n_; ++i) {
+    v[i] = (rng() & 1U) ? 1.0 : -1.0;
+    if (c.z[i] + 2 * d * v[i] > 1.0 || c.z[i] + 2 * d * v[i] < 0.0) v[i] = -v[i];  // stay in the box
+  }
+  std::vector<KnownPoint> probe;  // at d/4, d/2, d, 2d
+  std::vector<std::size_t> added;  // the probe's new points
+  auto smooth = [&] {              // no noise: the probe's points leave the fits
+    for (const std::size_t i : added) known_[i].probe_only = true;
+    return false;
+  };
+  for (const double t : {0.25, 0.5, 1.0, 2.0}) {
+    const std::size_t before = known_.size();
+    const auto idx = evaluate((c.z + t * d * v).cwiseMax(0.0).cwiseMin(1.0));
+    if (!idx) return std::nullopt;
+    if (known_.size() > before) added.push_back(*idx);
+    if (!known_[*idx].ok) return smooth();
+    probe.push_back(known_[*idx]);
+  }
+  const std::size_t responses = 1 + m_ineq_ + m_eq_;
+  std::vector<double> noise(responses, 0.0);
+  auto value = [&](const KnownPoint& p, std::size_t k) {
+    return k == 0 ? p.f : k <= m_ineq_ ? p.g[k - 1] : p.h[k - 1 - m_ineq_];
+  };
+  for (std::size_t k = 0; k < responses; ++k) {
+    const double y0 = value(c, k);
+    const double small = std::fabs(value(probe[1], k) - 2 * value(probe[0], k) + y0);
+    const double large = std::fabs(value(probe[3], k) - 2 * value(probe[2], k) + y0);
+    const double level = (small + large) / (2 * std::sqrt(6.0));
+    // rounding, not noise: a response linear along v has D ~ 1e-16 |y| at both steps
+    const bool above_rounding = level > kRounding * std::max(1.0, std::fabs(y0));
+    if (above_rounding && small >= large / 4) noise[k] = level;
+  }
+  const double sigma = detail::merit_noise(noise, c.g, m_ineq_, m_eq_, mu_, phase1);
+  if (kProbeRatio * sigma >= predicted) {
+    probed_noise_ = noise;
+    return true;
+  }
+  return smooth();
+}
+
+}  // namespace abuopt::opt::detail
