@@ -130,10 +130,11 @@ class Run {
     }
     choose_initial_modes();
     // The exact stuck-phase propagator needs the table of this run's omega_n and bbar (an
-    // imbalance-mass override changes both: such runs keep the Runge-Kutta path), no trajectory.
-    if (stuck_table && !rs_.pi_motor && event_driven_ && !(trajectory_ && traj_dt_ > 0) &&
+    // imbalance-mass override changes both: such runs keep the Runge-Kutta path), no trajectory,
+    // and no ball contact (not validated with contact yet: docs/stuck_propagator.md section 5).
+    if (stuck_table && !rs_.pi_motor && event_driven_ && !(trajectory_ && traj_dt_ > 0) && !rs_.contact &&
         stuck_table->matches(rs_.nd))
-      stuck_.emplace(*stuck_table, rs_, rs_.contact ? roots_contact : roots_plain);
+      stuck_.emplace(*stuck_table, rs_, roots_plain);
   }
 
   RunOutcome execute();
@@ -344,7 +345,13 @@ RunOutcome Run::execute() {
       // the next attempt of the closed-form tail) or the next stick -> slip root
       double stop = next_break < breaks.size() ? breaks[next_break] : t_end_;
       if (tail_enabled && t >= t_profile_ && next_tail_check > t) stop = std::min(stop, next_tail_check);
-      if (stuck_->advance(t, y, stop, rinfo_, peak_amp_) == StuckPropagator::Root) res = Integrator::Root;
+      const StuckPropagator::Result r = stuck_->advance(t, y, stop, rinfo_, peak_amp_);
+      if (r == StuckPropagator::NotFinite) {
+        out_.status = RunStatus::SolverFailure;
+        out_.message = "state not finite (exact stuck-phase propagator) at t = " + std::to_string(t / w_) + " s";
+        break;
+      }
+      if (r == StuckPropagator::Root) res = Integrator::Root;
       integ_stale = true;
     } else {
       if (integ_stale) {

@@ -283,6 +283,8 @@ StuckPropagator::Result StuckPropagator::advance(double& t, std::vector<double>&
   }
   std::copy(y.begin(), y.begin() + static_cast<long>(ywork_.size()), ywork_.begin());
   to_modal(t, y.data());
+  if (!(std::isfinite(std::abs(C_)) && std::isfinite(std::abs(a_[0])) && std::isfinite(std::abs(a_[1]))))
+    return NotFinite;
   g_(t, y.data(), g0_.data(), &rs_);
   double tc = t;
   std::size_t j = tab_.interval(tc);
@@ -305,6 +307,10 @@ StuckPropagator::Result StuckPropagator::advance(double& t, std::vector<double>&
     }
     ++intervals_;
     const double x = ywork_[StateLayout::x], yy = ywork_[StateLayout::y];
+    if (!std::isfinite(x * yy)) {
+      t = tn;
+      return NotFinite;
+    }
     peak_amp_mm = std::max(peak_amp_mm, std::sqrt(x * x + yy * yy) * L_mm_);
     if (g_ == roots_plain && tn == tab_.t(j + 1))
       margins(tab_.speed(j + 1), tab_.speed_rate(j + 1), ywork_.data(), g1_.data());

@@ -71,10 +71,11 @@ class StuckForcingTable {
 // earliest root of the stick functions (the integrator's root functions, offsets included).
 class StuckPropagator {
  public:
-  enum Result { Stop, Root };
+  enum Result { Stop, Root, NotFinite };
   StuckPropagator(const StuckForcingTable& tab, RunState& rs, RootFn g);
   // On Root: t and y are at the root (on the far side of the crossing, as the stepper's roots),
-  // roots[k] != 0 marks the functions that crossed. The peak table amplitude [mm] over the grid
+  // roots[k] != 0 marks the functions that crossed. NotFinite: the state is not finite (NaN or
+  // inf, e.g. from a non-finite angle); t and y are where it was found. The peak table amplitude [mm] over the grid
   // points passed is folded into peak_amp_mm.
   Result advance(double& t, std::vector<double>& y, double tstop, std::vector<int>& roots, double& peak_amp_mm);
   long intervals() const { return intervals_; }

@@ -176,6 +176,7 @@ TEST(StuckPropagator, WholeRunsAgreeWithTheRungeKuttaPathAtTightTolerance) {
   abuopt::SimulationSetup s;
   s.options.rtol = 1e-10;
   s.options.atol = 1e-13;
+  s.options.stuck_integrator = abuopt::StuckIntegrator::RungeKutta;
   abuopt::Simulator rk(s);
   s.options.stuck_integrator = abuopt::StuckIntegrator::Exact;
   abuopt::Simulator ex(s);
