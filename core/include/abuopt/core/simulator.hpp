@@ -55,7 +55,7 @@ struct SimulationOptions {
   // After the profile ends with all balls stuck the system is linear and time-invariant; when a
   // bound proves no ball can slip again the run jumps to the end time in closed form.
   bool closed_form_tail = true;
-  StuckIntegrator stuck_integrator = StuckIntegrator::RungeKutta;
+  StuckIntegrator stuck_integrator = StuckIntegrator::Exact;
   double trajectory_interval_s = 0;  // > 0: record a trajectory point every this many seconds
 };
 
