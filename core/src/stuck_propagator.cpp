@@ -80,6 +80,17 @@ StuckForcingTable::StuckForcingTable(const StartupProfile& profile, const Nondim
   const double tp = profile_.duration_s() * omega_n_;
   if (t_end_bar > tp) pieces.push_back({tp, t_end_bar, to_W * profile_.final_frequency_hz(), true});
 
+  // every vector's final size first: no reallocation while filling (the table is ~100 B per
+  // interval, ~17k intervals for the final profile)
+  std::size_t total = 1;
+  for (const Piece& pc : pieces)
+    total += static_cast<std::size_t>(std::max(1.0, std::ceil((pc.b - pc.a) / (kCheckFraction * 2.0 * M_PI / (pc.Wmax + wd)))));
+  t_.reserve(total);
+  W_.reserve(total);
+  Wp_.reserve(total);
+  rot_.reserve(total);
+  E_.reserve(2 * total);
+  P_.reserve(2 * total);
   t_.push_back(0.0);
   std::vector<cplx> wexp(2 * kNodes);
   auto push_point = [&](double W, double Wp, const cplx& e) {
