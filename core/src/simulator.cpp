@@ -12,10 +12,13 @@
 // root the modes of all balls are chosen together (AbuModel::choose_modes) and the integrator is
 // reset. After the profile ends with every ball stuck (ideal motor), the table motion is linear
 // and time-invariant; if a bound on its transient proves that no stick margin can reach zero, the
-// run is finished in closed form (closed_form_tail).
+// run is finished in closed form (closed_form_tail). While every ball is stuck (ideal motor, no
+// contact), the default stuck integrator propagates the table exactly instead of stepping
+// (stuck_propagator.hpp, docs/stuck_propagator.md); the stepper restarts at the next event.
 //
 // The parts: sim_rhs.cpp (right-hand side and root functions), closed_form_tail.cpp,
-// integrator_native.cpp and integrator_arkode.cpp (the back ends, integrator.hpp).
+// integrator_native.cpp and integrator_arkode.cpp (the back ends, integrator.hpp),
+// stuck_propagator.cpp (the exact all-stuck phases).
 #include "abuopt/core/simulator.hpp"
 
 #include <algorithm>
