@@ -70,8 +70,10 @@ Simulator::Simulator(SimulationSetup setup) : setup_(std::move(setup)) {
   // The exact stuck-phase propagator: its forcing integrals depend only on the profile and the
   // table, so they are computed once here and shared by every run.
   const NondimParameters nd = NondimParameters::from(setup_.abu);
+  // (Not with hard contact between two or more balls: such runs keep the Runge-Kutta path.)
+  const bool contact = setup_.abu.ball_contact == BallContact::Hard && setup_.abu.balls.size() >= 2;
   if (o.stuck_integrator == StuckIntegrator::Exact && o.method == FrictionMethod::EventDriven &&
-      setup_.motor.kind == MotorKind::Ideal && StuckForcingTable::supports(nd))
+      setup_.motor.kind == MotorKind::Ideal && !contact && StuckForcingTable::supports(nd))
     stuck_table_ = std::make_shared<const StuckForcingTable>(setup_.profile, nd, end_time_s() * nd.omega_n);
 }
 
