@@ -1,6 +1,7 @@
 // Accuracy of the default integrator settings against a tight-tolerance reference, over many
 // random initial conditions of the report's final profile (not a Google Benchmark: it prints a
 // table). Usage: simulator_accuracy [runs=1024] [rtol=1e-6] [reference_rtol=1e-10] [table]
+//   [stuck_integrator=default] [reference_stuck_integrator=default]   (rk or exact)
 // Reports: the largest final-angle difference, how many runs differ by more than 1e-3 rad,
 // and the mean CPU time per run of both settings.
 #include <algorithm>
@@ -30,7 +31,15 @@ int main(int argc, char** argv) {
   const double rtol = argc > 2 ? std::atof(argv[2]) : 1e-6;
   const double ref_rtol = argc > 3 ? std::atof(argv[3]) : 1e-10;
   SimulationSetup fast, ref;
-  if (argc > 4) fast.options.erk_table = ref.options.erk_table = argv[4];
+  if (argc > 4 && std::string(argv[4]) != "default") fast.options.erk_table = ref.options.erk_table = argv[4];
+  auto stuck = [](const std::string& v) {
+    if (v == "rk") return StuckIntegrator::RungeKutta;
+    if (v == "exact") return StuckIntegrator::Exact;
+    std::fprintf(stderr, "stuck integrator must be rk or exact, not '%s'\n", v.c_str());
+    std::exit(2);
+  };
+  if (argc > 5 && std::string(argv[5]) != "default") fast.options.stuck_integrator = stuck(argv[5]);
+  if (argc > 6 && std::string(argv[6]) != "default") ref.options.stuck_integrator = stuck(argv[6]);
   fast.options.rtol = rtol;
   fast.options.atol = rtol * 1e-3;
   ref.options.rtol = ref_rtol;
@@ -68,7 +77,9 @@ int main(int argc, char** argv) {
     mean_r += tr[i] / runs;
     mean_rhs += rhs[i] / runs;
   }
-  std::printf("runs %d  rtol %.1e vs reference %.1e  table %s\n", runs, rtol, ref_rtol, fast.options.erk_table.c_str());
+  std::printf("runs %d  rtol %.1e (stuck %s) vs reference %.1e (stuck %s)  table %s\n", runs, rtol,
+              to_string(fast.options.stuck_integrator).c_str(), ref_rtol, to_string(ref.options.stuck_integrator).c_str(),
+              fast.options.erk_table.c_str());
   std::printf("max |delta beta| %.3e rad, runs over 1e-3 rad: %d, failed: %d\n", worst, over, failed);
   std::printf("mean wall per run: %.3f ms (reference %.3f ms), mean RHS evaluations %.0f\n", mean_f * 1e3, mean_r * 1e3, mean_rhs);
   return over == 0 && failed == 0 ? 0 : 1;

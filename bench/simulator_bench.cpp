@@ -4,6 +4,7 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <cstdint>
 #include <random>
 
 #include "abuopt/core/abu_model.hpp"
@@ -11,27 +12,36 @@
 
 namespace {
 
-abuopt::SimulationSetup final_profile(abuopt::IntegratorBackend backend, double rtol) {
+abuopt::SimulationSetup final_profile(abuopt::IntegratorBackend backend, double rtol,
+                                      abuopt::StuckIntegrator stuck) {
   abuopt::SimulationSetup s;  // defaults: report table 3.2, mu = 0.02, the report's final profile
   s.options.backend = backend;
   s.options.rtol = rtol;
   s.options.atol = rtol * 1e-3;  // the default pair is rtol 1e-6, atol 1e-9
+  s.options.stuck_integrator = stuck;
   return s;
 }
 
-// Fixed initial conditions, cycled: 16 angle pairs from a fixed seed.
-std::vector<std::vector<double>> fixed_initial_conditions() {
+abuopt::StuckIntegrator stuck_arg(std::int64_t a) {
+  return a ? abuopt::StuckIntegrator::Exact : abuopt::StuckIntegrator::RungeKutta;
+}
+
+// Fixed initial conditions, cycled: 16 angle tuples from a fixed seed.
+std::vector<std::vector<double>> fixed_initial_conditions(std::size_t balls = 2) {
   std::mt19937_64 rng(2003);
   std::uniform_real_distribution<double> u(0, 2 * M_PI);
   std::vector<std::vector<double>> v;
-  for (int i = 0; i < 16; ++i) v.push_back({u(rng), u(rng)});
+  for (int i = 0; i < 16; ++i) {
+    std::vector<double> b;
+    for (std::size_t k = 0; k < balls; ++k) b.push_back(u(rng));
+    v.push_back(b);
+  }
   return v;
 }
 
-void run_profile(benchmark::State& state, abuopt::IntegratorBackend backend) {
-  const double rtol = std::pow(10.0, -static_cast<double>(state.range(0)));
-  abuopt::Simulator sim(final_profile(backend, rtol));
-  const auto ics = fixed_initial_conditions();
+// Runs the simulator over the fixed starts; counters per run.
+void run_cycle(benchmark::State& state, const abuopt::Simulator& sim) {
+  const auto ics = fixed_initial_conditions(sim.ball_count());
   std::size_t k = 0;
   double rhs = 0, steps = 0, events = 0, runs = 0;
   for (auto _ : state) {
@@ -47,15 +57,71 @@ void run_profile(benchmark::State& state, abuopt::IntegratorBackend backend) {
   state.counters["events_per_run"] = events / runs;
 }
 
+// Args: -log10(rtol), stuck integrator (0 rk, 1 exact).
+void run_profile(benchmark::State& state, abuopt::IntegratorBackend backend) {
+  const double rtol = std::pow(10.0, -static_cast<double>(state.range(0)));
+  abuopt::Simulator sim(final_profile(backend, rtol, stuck_arg(state.range(1))));
+  run_cycle(state, sim);
+}
+
 void BM_FinalProfileRun_Native(benchmark::State& state) { run_profile(state, abuopt::IntegratorBackend::Native); }
 void BM_FinalProfileRun_Arkode(benchmark::State& state) { run_profile(state, abuopt::IntegratorBackend::ArkodeErk); }
-BENCHMARK(BM_FinalProfileRun_Native)->Arg(6)->Arg(8)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_FinalProfileRun_Arkode)->Arg(6)->Unit(benchmark::kMillisecond)->Iterations(32);
+BENCHMARK(BM_FinalProfileRun_Native)
+    ->ArgsProduct({{6, 8}, {0, 1}})
+    ->ArgNames({"rtol_exp", "exact"})
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FinalProfileRun_Arkode)->Args({6, 0})->Unit(benchmark::kMillisecond)->Iterations(32);
+
+// Cost against the tolerance (-log10 rtol 4..10), both stuck integrators.
+void BM_Tolerance(benchmark::State& state) { run_profile(state, abuopt::IntegratorBackend::Native); }
+BENCHMARK(BM_Tolerance)
+    ->ArgsProduct({{4, 5, 6, 7, 8, 9, 10}, {0, 1}})
+    ->ArgNames({"rtol_exp", "exact"})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(64);
+
+// Cost against the number of balls (identical balls of the report, no contact), final profile.
+void BM_BallCount(benchmark::State& state) {
+  abuopt::SimulationSetup s = final_profile(abuopt::IntegratorBackend::Native, 1e-6, stuck_arg(state.range(1)));
+  s.abu.balls.assign(static_cast<std::size_t>(state.range(0)), abuopt::Ball{});
+  abuopt::Simulator sim(s);
+  run_cycle(state, sim);
+}
+BENCHMARK(BM_BallCount)
+    ->ArgsProduct({{2, 3, 4, 6, 9}, {0, 1}})
+    ->ArgNames({"balls", "exact"})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(64);
+
+// Cost against the profile's length: the final profile with every duration scaled so that it
+// lasts T s (end time 2T, the report's rule).
+void BM_ProfileLength(benchmark::State& state) {
+  abuopt::SimulationSetup s = final_profile(abuopt::IntegratorBackend::Native, 1e-6, stuck_arg(state.range(1)));
+  const double scale = static_cast<double>(state.range(0)) / 19.0;
+  s.profile = abuopt::StartupProfile({{25.0, 1.0 * scale}, {29.5, 10.0 * scale}, {100.0, 8.0 * scale}});
+  abuopt::Simulator sim(s);
+  run_cycle(state, sim);
+}
+BENCHMARK(BM_ProfileLength)
+    ->ArgsProduct({{10, 19, 30, 45, 60}, {0, 1}})
+    ->ArgNames({"seconds", "exact"})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(64);
+
+// Building a Simulator: with the exact stuck integrator this computes the forcing table once.
+void BM_SimulatorSetup(benchmark::State& state) {
+  const auto s = final_profile(abuopt::IntegratorBackend::Native, 1e-6, stuck_arg(state.range(0)));
+  for (auto _ : state) {
+    abuopt::Simulator sim(s);
+    benchmark::DoNotOptimize(&sim);
+  }
+}
+BENCHMARK(BM_SimulatorSetup)->Arg(0)->Arg(1)->ArgName("exact")->Unit(benchmark::kMillisecond);
 
 // Ball contact: the same 16 starts (mapped onto the feasible set by the simulator when they
 // overlap), contact none vs hard, in one program run so the ratio is measured under one load.
 void run_contact(benchmark::State& state, abuopt::BallContact contact) {
-  abuopt::SimulationSetup s = final_profile(abuopt::IntegratorBackend::Native, 1e-6);
+  abuopt::SimulationSetup s = final_profile(abuopt::IntegratorBackend::Native, 1e-6, abuopt::StuckIntegrator::Exact);
   s.abu.ball_contact = contact;
   abuopt::Simulator sim(s);
   const auto ics = fixed_initial_conditions();

@@ -33,6 +33,18 @@ StartupProfile::StartupProfile(std::vector<InclinedSineSegment> segments, double
     breaks_.push_back(t);
   }
   duration_s_ = t;
+  revs_.assign(1, 0.0);
+  for (std::size_t k = 0; k < segments_.size(); ++k) {
+    // a whole segment: tau = dt, the sine term vanishes
+    const double f0 = k == 0 ? start_hz_ : segments_[k - 1].end_frequency_hz;
+    revs_.push_back(revs_.back() + 0.5 * (f0 + segments_[k].end_frequency_hz) * segments_[k].duration_s);
+  }
+}
+
+double StartupProfile::revolutions(double t) const {
+  double r = 0;
+  sample(t, &r);
+  return r;
 }
 
 StartupProfile StartupProfile::report_final() {
@@ -43,14 +55,16 @@ double StartupProfile::final_frequency_hz() const {
   return segments_.empty() ? start_hz_ : segments_.back().end_frequency_hz;
 }
 
-ProfileSample StartupProfile::sample(double t) const {
+ProfileSample StartupProfile::sample(double t, double* revolutions) const {
   ProfileSample s;
   if (segments_.empty() || t <= 0) {
     s.frequency_hz = start_hz_;
+    if (revolutions) *revolutions = start_hz_ * t;
     return s;
   }
   if (t >= duration_s_) {
     s.frequency_hz = final_frequency_hz();
+    if (revolutions) *revolutions = revs_.back() + s.frequency_hz * (t - duration_s_);
     return s;
   }
   // Segment index: last breakpoint <= t.
@@ -65,6 +79,10 @@ ProfileSample StartupProfile::sample(double t) const {
   s.frequency_hz = f0 + H / kTwoPi * phi_minus_sin(phi, 2.0 * sh * ch);
   s.rate_hz_per_s = 2.0 * H / dt * sh * sh;  // H/dt (1 - cos phi), without cancellation
   s.accel_hz_per_s2 = kTwoPi * H / (dt * dt) * 2.0 * sh * ch;
+  if (revolutions) {
+    const double tau = t - t0;  // sh = sin(pi tau / dt)
+    *revolutions = revs_[k] + f0 * tau + H * (0.5 * tau * tau / dt - dt / (2.0 * M_PI * M_PI) * sh * sh);
+  }
   return s;
 }
 

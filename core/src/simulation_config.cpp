@@ -11,6 +11,8 @@ const EnumNames<FrictionMethod> kFrictionMethodNames = {{FrictionMethod::EventDr
 const EnumNames<BallContact> kBallContactNames = {{BallContact::None, "none"}, {BallContact::Hard, "hard"}};
 const EnumNames<IntegratorBackend> kIntegratorNames = {{IntegratorBackend::Native, "native"},
                                                        {IntegratorBackend::ArkodeErk, "arkode_erk"}};
+const EnumNames<StuckIntegrator> kStuckIntegratorNames = {{StuckIntegrator::RungeKutta, "rk"},
+                                                          {StuckIntegrator::Exact, "exact"}};
 
 namespace {
 
@@ -133,6 +135,7 @@ void describe_fields(FieldArchive& a, SimulationOptions& o) {
   a.field("chatter_events", o.chatter_events, Rule::at_least(1));
   a.field("chatter_window_s", o.chatter_window_s, Rule::positive());
   a.field("closed_form_tail", o.closed_form_tail);
+  a.field("stuck_integrator", o.stuck_integrator, kStuckIntegratorNames);
   a.field("trajectory_interval_s", o.trajectory_interval_s, Rule::non_negative());
 }
 

@@ -12,10 +12,13 @@
 // root the modes of all balls are chosen together (AbuModel::choose_modes) and the integrator is
 // reset. After the profile ends with every ball stuck (ideal motor), the table motion is linear
 // and time-invariant; if a bound on its transient proves that no stick margin can reach zero, the
-// run is finished in closed form (closed_form_tail).
+// run is finished in closed form (closed_form_tail). While every ball is stuck (ideal motor, no
+// contact), the default stuck integrator propagates the table exactly instead of stepping
+// (stuck_propagator.hpp, docs/stuck_propagator.md); the stepper restarts at the next event.
 //
 // The parts: sim_rhs.cpp (right-hand side and root functions), closed_form_tail.cpp,
-// integrator_native.cpp and integrator_arkode.cpp (the back ends, integrator.hpp).
+// integrator_native.cpp and integrator_arkode.cpp (the back ends, integrator.hpp),
+// stuck_propagator.cpp (the exact all-stuck phases).
 #include "abuopt/core/simulator.hpp"
 
 #include <algorithm>
@@ -23,6 +26,7 @@
 #include <cmath>
 #include <deque>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <sstream>
 
@@ -31,11 +35,13 @@
 #include "abuopt/core/simulation_config.hpp"
 #include "integrator.hpp"
 #include "sim_run_state.hpp"
+#include "stuck_propagator.hpp"
 
 namespace abuopt {
 
 std::string to_string(FrictionMethod m) { return m == FrictionMethod::EventDriven ? "event_driven" : "switch_model"; }
 std::string to_string(IntegratorBackend b) { return b == IntegratorBackend::ArkodeErk ? "arkode_erk" : "native"; }
+std::string to_string(StuckIntegrator s) { return s == StuckIntegrator::Exact ? "exact" : "rk"; }
 std::string to_string(RunStatus s) {
   switch (s) {
     case RunStatus::Ok: return "ok";
@@ -61,6 +67,14 @@ Simulator::Simulator(SimulationSetup setup) : setup_(std::move(setup)) {
   if (setup_.abu.ball_contact == BallContact::Hard && o.method != FrictionMethod::EventDriven)
     throw ConfigError("abu.ball_contact", "hard",
                       "needs simulation.method = event_driven (the switch model has no contact events)");
+  // The exact stuck-phase propagator: its forcing integrals depend only on the profile and the
+  // table, so they are computed once here and shared by every run.
+  const NondimParameters nd = NondimParameters::from(setup_.abu);
+  // (Not with hard contact between two or more balls: such runs keep the Runge-Kutta path.)
+  const bool contact = setup_.abu.ball_contact == BallContact::Hard && setup_.abu.balls.size() >= 2;
+  if (o.stuck_integrator == StuckIntegrator::Exact && o.method == FrictionMethod::EventDriven &&
+      setup_.motor.kind == MotorKind::Ideal && !contact && StuckForcingTable::supports(nd))
+    stuck_table_ = std::make_shared<const StuckForcingTable>(setup_.profile, nd, end_time_s() * nd.omega_n);
 }
 
 Simulator::~Simulator() = default;
@@ -77,7 +91,7 @@ namespace {
 class Run {
  public:
   Run(const SimulationSetup& setup, double end_time_s, const std::vector<double>& beta0, const RunOverrides& ov,
-      std::vector<TrajectoryPoint>* trajectory)
+      std::vector<TrajectoryPoint>* trajectory, const StuckForcingTable* stuck_table)
       : setup_(setup), p_(with_overrides(setup.abu, ov)), rs_(p_), lay_(rs_.lay()), trajectory_(trajectory) {
     rs_.profile = &setup_.profile;
     rs_.motor = setup_.motor;
@@ -120,6 +134,12 @@ class Run {
       contact_setup(rs_, y_.data());
     }
     choose_initial_modes();
+    // The exact stuck-phase propagator needs the table of this run's omega_n and bbar (an
+    // imbalance-mass override changes both: such runs keep the Runge-Kutta path), no trajectory,
+    // and no ball contact (not validated with contact yet: docs/stuck_propagator.md section 5).
+    if (stuck_table && !rs_.pi_motor && event_driven_ && !(trajectory_ && traj_dt_ > 0) && !rs_.contact &&
+        stuck_table->matches(rs_.nd))
+      stuck_.emplace(*stuck_table, rs_, roots_plain);
   }
 
   RunOutcome execute();
@@ -163,6 +183,7 @@ class Run {
   std::vector<char> fixed_;
   std::deque<double> recent_events_;
   std::vector<double> ref_steps_;  // step times of the quantised reference (tbar), sorted
+  std::optional<StuckPropagator> stuck_;
 };
 
 void Run::hold_reference_after(double tbar) {
@@ -320,26 +341,48 @@ RunOutcome Run::execute() {
     next_traj = traj_dt_;
   }
 
+  const bool tail_enabled = event_driven_ && rs_.opt.closed_form_tail && !rs_.pi_motor && !tracing;
+  bool integ_stale = false;  // the exact propagator moved (t, y): the stepper restarts from there
   while (t < t_end_) {
-    const Integrator::Result res = integ.step(t, y, rinfo_);
-    if (res == Integrator::Failure) {
-      out_.status = integ.too_much_work() ? RunStatus::StepLimit : RunStatus::SolverFailure;
-      out_.message = integ.failure() + " at t = " + std::to_string(t / w_) + " s";
-      break;
-    }
-    if (tracing) {
-      while (next_traj <= t && next_traj <= t_end_) {
-        integ.dense(next_traj, ytraj);
-        record(next_traj, ytraj);
-        next_traj += traj_dt_;
+    Integrator::Result res = Integrator::Ok;
+    if (stuck_ && rs_.frozen) {
+      // every ball stuck: the exact propagator, to the next stop time (a breakpoint, the end, or
+      // the next attempt of the closed-form tail) or the next stick -> slip root
+      double stop = next_break < breaks.size() ? breaks[next_break] : t_end_;
+      if (tail_enabled && t >= t_profile_ && next_tail_check > t) stop = std::min(stop, next_tail_check);
+      const StuckPropagator::Result r = stuck_->advance(t, y, stop, rinfo_, peak_amp_);
+      if (r == StuckPropagator::NotFinite) {
+        out_.status = RunStatus::SolverFailure;
+        out_.message = "state not finite (exact stuck-phase propagator) at t = " + std::to_string(t / w_) + " s";
+        break;
       }
-    }
-    peak_amp_ = std::max(peak_amp_, std::hypot(y[StateLayout::x], y[StateLayout::y]) * L_mm_);
+      if (r == StuckPropagator::Root) res = Integrator::Root;
+      integ_stale = true;
+    } else {
+      if (integ_stale) {
+        integ.reset(t, y);
+        integ_stale = false;
+      }
+      res = integ.step(t, y, rinfo_);
+      if (res == Integrator::Failure) {
+        out_.status = integ.too_much_work() ? RunStatus::StepLimit : RunStatus::SolverFailure;
+        out_.message = integ.failure() + " at t = " + std::to_string(t / w_) + " s";
+        break;
+      }
+      if (tracing) {
+        while (next_traj <= t && next_traj <= t_end_) {
+          integ.dense(next_traj, ytraj);
+          record(next_traj, ytraj);
+          next_traj += traj_dt_;
+        }
+      }
+      peak_amp_ = std::max(peak_amp_, std::hypot(y[StateLayout::x], y[StateLayout::y]) * L_mm_);
 
-    if (!event_driven_) {
-      // switch model: track the all-stuck period at step ends
-      switch_modes(rs_, t, y.data());
-      track_all_stuck(t);
+      if (!event_driven_) {
+        // switch model: track the all-stuck period at step ends
+        switch_modes(rs_, t, y.data());
+        track_all_stuck(t);
+      }
     }
 
     bool reset_needed = false;
@@ -357,8 +400,7 @@ RunOutcome Run::execute() {
     }
     if (t >= t_end_) break;
 
-    if (event_driven_ && rs_.opt.closed_form_tail && !rs_.pi_motor && !tracing && t >= t_profile_ &&
-        t >= next_tail_check && all_stuck_since_ >= 0) {
+    if (tail_enabled && t >= t_profile_ && t >= next_tail_check && all_stuck_since_ >= 0) {
       if (closed_form_tail(rs_, t, y, t_end_, peak_amp_)) {
         t = t_end_;
         break;
@@ -368,6 +410,7 @@ RunOutcome Run::execute() {
     if (reset_needed) {
       if (rs_.contact) set_root_offsets(rs_, t, y.data());
       integ.reset(t, y);
+      integ_stale = false;
       set_root_offsets(rs_, t, y.data());
     }
   }
@@ -375,7 +418,7 @@ RunOutcome Run::execute() {
 }
 
 RunOutcome Run::finish(const Integrator& integ) {
-  out_.steps = integ.steps();
+  out_.steps = integ.steps() + (stuck_ ? stuck_->intervals() : 0);
   out_.rhs_evaluations = rs_.rhs_evals;
   out_.max_amplitude_mm = peak_amp_;
   for (std::size_t i = 0; i < rs_.n; ++i) out_.beta_final.push_back(wrap_angle(y_[lay_.beta(i)]));
@@ -397,7 +440,7 @@ RunOutcome Simulator::run(const std::vector<double>& beta0, const RunOverrides& 
   if (beta0.size() != setup_.abu.balls.size())  // API misuse: the caller sizes beta0 from ball_count()
     throw std::invalid_argument("Simulator::run: the ABU has " + std::to_string(setup_.abu.balls.size()) +
                                 " balls, but " + std::to_string(beta0.size()) + " initial angles were given");
-  Run run(setup_, end_time_s(), beta0, ov, trajectory);
+  Run run(setup_, end_time_s(), beta0, ov, trajectory, stuck_table_.get());
   RunOutcome out = run.execute();
   out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return out;

@@ -58,3 +58,24 @@ TEST(StartupProfile, ValidationNamesTheSegment) {
     EXPECT_STREQ(e.what(), "profile.segments[1].duration_s = -2: must be > 0");
   }
 }
+
+// The disc's turns: the integral of f. Whole segments are trapezoids (the sine term integrates to
+// zero over a period); inside a segment the derivative is f; after the profile f_final t.
+TEST(StartupProfile, RevolutionsIntegrateTheFrequency) {
+  const StartupProfile p = StartupProfile::report_final();
+  EXPECT_DOUBLE_EQ(p.revolutions(0.0), 0.0);
+  EXPECT_NEAR(p.revolutions(1.0), 12.5, 1e-12);
+  EXPECT_NEAR(p.revolutions(11.0), 12.5 + 272.5, 1e-11);
+  EXPECT_NEAR(p.revolutions(19.0), 12.5 + 272.5 + 518.0, 1e-10);
+  EXPECT_NEAR(p.revolutions(21.0), 803.0 + 200.0, 1e-10);
+  for (double t : {0.3, 0.9999, 1.0001, 2.7, 9.9, 14.2, 18.9999}) {
+    const double h = 1e-5;
+    const double fd = (p.revolutions(t + h) - p.revolutions(t - h)) / (2 * h);
+    EXPECT_NEAR(fd, p.frequency_hz(t), 1e-7 * (1 + p.frequency_hz(t))) << t;
+  }
+  // Simpson on a segment against the closed form
+  const int n = 2000;
+  double s = 0;
+  for (int i = 0; i <= n; ++i) s += (i == 0 || i == n ? 1 : (i % 2 ? 4 : 2)) * p.frequency_hz(11.0 + 3.3 * i / n);
+  EXPECT_NEAR(s * 3.3 / n / 3, p.revolutions(14.3) - p.revolutions(11.0), 1e-9);
+}

@@ -37,7 +37,13 @@ class StartupProfile {
   // The report's final design: 0 -> 25 Hz in 1 s, 25 -> 29.5 Hz in 10 s, 29.5 -> 100 Hz in 8 s.
   static StartupProfile report_final();
 
-  ProfileSample sample(double t_s) const;
+  ProfileSample sample(double t_s) const { return sample(t_s, nullptr); }
+  // The same, and the revolutions (below) into *revolutions when given, from the same sine.
+  ProfileSample sample(double t_s, double* revolutions) const;
+  // Turns of the disc since t = 0: the integral of f from 0 to t_s, in closed form per segment
+  //   int_0^tau f = f0 tau + H tau^2/(2 dt) - H dt/(2 pi^2) sin^2(pi tau/dt),
+  // and f_final (t_s - duration) after the profile (the phase of the disc: 2 pi revolutions).
+  double revolutions(double t_s) const;
   double frequency_hz(double t_s) const { return sample(t_s).frequency_hz; }
   double duration_s() const { return duration_s_; }
   double start_frequency_hz() const { return start_hz_; }
@@ -53,6 +59,7 @@ class StartupProfile {
  private:
   std::vector<InclinedSineSegment> segments_;
   std::vector<double> breaks_{0.0};
+  std::vector<double> revs_{0.0};  // revolutions at each breakpoint
   double start_hz_ = 0.0;
   double duration_s_ = 0.0;
 };

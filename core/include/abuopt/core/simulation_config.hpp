@@ -15,6 +15,7 @@ namespace abuopt {
 extern const EnumNames<MotorKind> kMotorKindNames;             // ideal, pi
 extern const EnumNames<FrictionMethod> kFrictionMethodNames;   // event_driven, switch_model
 extern const EnumNames<IntegratorBackend> kIntegratorNames;
+extern const EnumNames<StuckIntegrator> kStuckIntegratorNames;  // rk, exact
 extern const EnumNames<BallContact> kBallContactNames;        // none, hard    // native, arkode_erk
 
 // The field lists. `abu` also accepts the shorthand ball_count/ball_mass_kg/ball_diameter_m for

@@ -9,6 +9,7 @@
 // option on the same model. Integration uses the native explicit Runge-Kutta stepper with
 // ARKODE's Butcher tables by default (IntegratorBackend::Native); SUNDIALS ARKODE's ERKStep is
 // the reference back end (ArkodeErk). Numerical trouble is an outcome status, never an exception.
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -20,12 +21,22 @@
 
 namespace abuopt {
 
+namespace detail {
+class StuckForcingTable;
+}
+
 enum class FrictionMethod { EventDriven, SwitchModel };
 // Native: our lean explicit RK stepper with ARKODE's Butcher tables (fast, the default).
 // ArkodeErk: SUNDIALS ARKODE ERKStep with its own root finding (the reference; ~20x slower here).
 enum class IntegratorBackend { Native, ArkodeErk };
+// While every ball is stuck (event-driven, ideal motor): RungeKutta integrates the table rows with
+// the back end's stepper; Exact propagates them with the exact solution of the linear table
+// (docs/stuck_propagator.md), checking the stick margins on a grid of half a period of their
+// fastest oscillation and locating stick -> slip events on the exact solution.
+enum class StuckIntegrator { RungeKutta, Exact };
 std::string to_string(FrictionMethod m);
 std::string to_string(IntegratorBackend b);
+std::string to_string(StuckIntegrator s);
 
 struct SimulationOptions {
   FrictionMethod method = FrictionMethod::EventDriven;
@@ -44,6 +55,7 @@ struct SimulationOptions {
   // After the profile ends with all balls stuck the system is linear and time-invariant; when a
   // bound proves no ball can slip again the run jumps to the end time in closed form.
   bool closed_form_tail = true;
+  StuckIntegrator stuck_integrator = StuckIntegrator::Exact;
   double trajectory_interval_s = 0;  // > 0: record a trajectory point every this many seconds
 };
 
@@ -85,6 +97,9 @@ class Simulator {
 
  private:
   SimulationSetup setup_;
+  // The forcing integrals of the exact stuck-phase propagator, shared by all runs (null when the
+  // Runge-Kutta path is used).
+  std::shared_ptr<const detail::StuckForcingTable> stuck_table_;
 };
 
 }  // namespace abuopt
