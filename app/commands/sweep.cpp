@@ -118,9 +118,14 @@ int run_sweep_command(const SweepArgs& a) {
       os << std::setprecision(6) << p.e.objective;
     else
       os << "FAILED (" << p.e.message << ")";
-    os << "  viol=" << std::setprecision(3) << p.max_violation
-       << (p.from_archive ? "  [archive]" : "  [computed " + format_number(std::round(p.wall_time_s * 10) / 10) + " s]");
+    os << "  viol=";
+    if (p.e.ok)
+      os << std::setprecision(3) << p.max_violation;
+    else
+      os << "-";
+    os << (p.from_archive ? "  [archive]" : "  [computed " + format_number(std::round(p.wall_time_s * 10) / 10) + " s]");
     const double rate = elapsed > 0 ? static_cast<double>(done) / elapsed : 0;
+    if (rate > 0) os << "  " << std::setprecision(3) << rate << " points/s";
     if (done < total && rate > 0) os << "  ETA " << std::llround(static_cast<double>(total - done) / rate) << " s";
     log << os.str() << "\n" << std::flush;
   };

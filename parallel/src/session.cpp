@@ -106,7 +106,7 @@ std::size_t chunk_size(std::size_t left, std::size_t threads) {
 
 // Fault injection for the tests of faults (tests/app/mpi_cli_test.cpp): ABUOPT_TEST_FAULT =
 // "throw:R[:K]" makes serving rank R throw in its K-th chunk (default 1), "die:R[:K]" kills it
-// there (SIGKILL).
+// there (SIGKILL); "die_job:R:J" (below) kills it when its J-th study arrives.
 void injected_fault() {
   static const char* v = std::getenv("ABUOPT_TEST_FAULT");
   static long chunks = 0;
@@ -125,9 +125,26 @@ void injected_fault() {
     throw std::runtime_error("fault injected by ABUOPT_TEST_FAULT=" + spec);
 }
 
+// "die_job:R:J" kills serving rank R when it receives its J-th study (deterministic, unlike a
+// chunk count, which depends on how the dynamic scheduling shares the runs out).
+void injected_job_fault() {
+  static const char* v = std::getenv("ABUOPT_TEST_FAULT");
+  static long jobs = 0;
+  if (!v) return;
+  const std::string spec(v);
+  if (spec.rfind("die_job:", 0) != 0) return;
+  const auto second = spec.find(':', 8);
+  if (second == std::string::npos) return;
+  int rank = -1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  if (std::atoi(spec.c_str() + 8) != rank) return;
+  if (++jobs == std::atol(spec.c_str() + second + 1)) std::raise(SIGKILL);
+}
+
 // A serving rank's part of one study: the setup once, then chunks of run inputs until rank 0
 // says the study is over.
 void serve_job(Reader& in) {
+  injected_job_fault();
   const auto job = in.get<std::uint64_t>();
   const auto threads = static_cast<std::size_t>(in.get<std::uint64_t>());
   const std::string text = in.get_string();
