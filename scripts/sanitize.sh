@@ -50,7 +50,7 @@ asan_test() {
     --output-on-failure -j "$jobs"
 }
 
-tsan_targets=(monte_carlo_test evaluation_archive_test minimize_test startup_profile_problem_test)
+tsan_targets=(monte_carlo_test evaluation_archive_test minimize_test startup_profile_problem_test evaluation_batch_test startup_batch_test)
 tsan_build() {
   configure build-tsan "-fsanitize=thread"
   cmake --build build-tsan -j "$jobs" --target "${tsan_targets[@]}"
@@ -58,7 +58,7 @@ tsan_build() {
 tsan_test() {
   # setarch -R: kernels with 28+ bits of mmap randomisation break TSan's memory layout
   # ("unexpected memory mapping"); without address randomisation it runs.
-  local regex="^(MonteCarlo|EvaluationArchive|ArchivedProblem|Minimize|StartupProfileProblem)"
+  local regex="^(MonteCarlo|EvaluationArchive|ArchivedProblem|Minimize|StartupProfileProblem|EvaluationBatch|StartupBatch)"
   TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 \
     setarch "$(uname -m)" -R ctest --test-dir build-tsan -LE long -R "$regex" -E "_NOT_BUILT$" \
     --output-on-failure -j "$jobs"

@@ -211,9 +211,18 @@ TEST(EvaluationBatch, ThreadSchedulerCallsEveryTaskOnceAndRethrows) {
 TEST(EvaluationBatch, ProblemsThatAreNotThreadSafeRunOneAtATime) {
   // a FunctionProblem is not thread-safe unless declared so
   std::atomic<int> in_flight{0}, most{0};
+  std::atomic<bool> wait_for_company{false};
   opt::FunctionProblem f("sphere", {{"a", -1, 1}, {"b", -1, 1}}, [&](const std::vector<double>& x) {
     const int now = ++in_flight;
     most = std::max(most.load(), now);
+    // Thread-safe case: stay until a second evaluation is in flight too (at most 10 s; once an
+    // overlap was seen nobody waits), so the overlap is shown without depending on how the threads
+    // are scheduled (a 1 ms sleep was not enough under ThreadSanitizer on a loaded machine).
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (wait_for_company.load() && most.load() < 2 && in_flight.load() < 2 &&
+           std::chrono::steady_clock::now() < until)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    most = std::max(most.load(), in_flight.load());
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
     --in_flight;
     opt::Evaluation e;
@@ -227,6 +236,7 @@ TEST(EvaluationBatch, ProblemsThatAreNotThreadSafeRunOneAtATime) {
   EXPECT_EQ(most.load(), 1);
   f.set_thread_safe(true);
   most = 0;
+  wait_for_company = true;
   f.evaluate_batch({{0, 0}, {0.5, 0}, {0, 0.5}, {1, 1}}, s);
   EXPECT_GE(most.load(), 2);
 }
