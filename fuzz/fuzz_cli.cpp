@@ -1,6 +1,9 @@
 // libFuzzer target: the command line. The input is split at newlines into arguments (at most 24)
-// and parsed by the real `abuopt` CLI definition with every command's action replaced by a no-op,
-// so only parsing, conversion and validation of options run (never a study, never a file write).
+// and parsed by the real `abuopt` CLI definition; the app's parse-complete callback, which CLI11
+// runs after every option is converted and before any command's action, throws, so only parsing,
+// conversion and validation of options run (never a study, never a file write). (Replacing each
+// command's action with a no-op instead destroyed the shared arguments its lambda owned, and the
+// options then wrote into freed memory: a finding of this target in the harness itself.)
 // Parsing may only succeed or throw CLI11's ParseError or ConfigError; anything else is a finding.
 #include <cstdint>
 #include <string>
@@ -16,6 +19,11 @@ namespace abuopt::app {
 void set_exit_code(int) {}
 int exit_code() { return 0; }
 }  // namespace abuopt::app
+
+namespace {
+// Thrown when every option of the input is converted and validated, before any command's action.
+struct ParsedOnly {};
+}  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size > 4096) return 0;
@@ -41,7 +49,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   abuopt::app::register_reproduce(app);
   abuopt::app::register_compare(app);
   abuopt::app::register_optimize(app);
-  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) sub->callback([] {});
+  abuopt::app::register_sweep(app);
+  abuopt::app::register_pareto(app);
+  abuopt::app::register_archive(app);
+  app.parse_complete_callback([] { throw ParsedOnly{}; });
 
   std::vector<const char*> argv;
   for (const auto& a : args) argv.push_back(a.c_str());
@@ -49,6 +60,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     app.parse(static_cast<int>(argv.size()), argv.data());
   } catch (const CLI::ParseError&) {
   } catch (const abuopt::ConfigError&) {
+  } catch (const ParsedOnly&) {
   }
   return 0;
 }
