@@ -67,6 +67,9 @@ TEST(SimulatorRobustness, ArkodeBackendWithABadTableLeaksNothing) {
   // Before: the constructor threw after allocating ARKODE's memory and vector (~10 kB each time).
   SimulationSetup s;
   s.options.backend = IntegratorBackend::ArkodeErk;
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "ASan's quarantine keeps freed memory resident; LeakSanitizer checks this build for leaks instead";
+#endif
   s.options.erk_table = "NOT_A_TABLE";
   Simulator sim(s);
   auto attempt = [&] {
