@@ -72,15 +72,7 @@ int run_cli(int argc, char** argv) {
   app.footer("\n" + abuopt::terms_text(""));
   app.require_subcommand(1);
   app.set_version_flag("--version", "abuopt " + abuopt::abuopt_version() + " (" + abuopt::abuopt_git_commit() + ")");
-  abuopt::app::register_simulate(app);
-  abuopt::app::register_montecarlo(app);
-  abuopt::app::register_eqset(app);
-  abuopt::app::register_reproduce(app);
-  abuopt::app::register_compare(app);
-  abuopt::app::register_optimize(app);
-  abuopt::app::register_sweep(app);
-  abuopt::app::register_pareto(app);
-  abuopt::app::register_archive(app);
+  abuopt::app::register_all(app);
 
   try {
     app.parse(argc, argv);

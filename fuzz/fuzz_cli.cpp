@@ -43,15 +43,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   CLI::App app{"abuopt"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "abuopt fuzz");
-  abuopt::app::register_simulate(app);
-  abuopt::app::register_montecarlo(app);
-  abuopt::app::register_eqset(app);
-  abuopt::app::register_reproduce(app);
-  abuopt::app::register_compare(app);
-  abuopt::app::register_optimize(app);
-  abuopt::app::register_sweep(app);
-  abuopt::app::register_pareto(app);
-  abuopt::app::register_archive(app);
+  abuopt::app::register_all(app);
   app.parse_complete_callback([] { throw ParsedOnly{}; });
 
   std::vector<const char*> argv;
