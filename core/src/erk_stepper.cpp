@@ -33,7 +33,7 @@ ButcherTable ButcherTable::from_arkode(const std::string& name) {
 ErkStepper::ErkStepper(ButcherTable table, std::size_t n, RhsFn f, RootFn g, std::size_t nroots, void* user,
                        double rtol, double atol, long max_steps)
     : tab_(std::move(table)), n_(n), nroots_(nroots), f_(f), g_(g), user_(user), rtol_(rtol), atol_(atol),
-      max_steps_(max_steps) {
+      max_steps_(max_steps), ctr_(sim_counters()) {
   const std::size_t s = static_cast<std::size_t>(tab_.stages);
   a_terms_.resize(s);
   for (int i = 0; i < tab_.stages; ++i)
@@ -65,7 +65,12 @@ void ErkStepper::reset(double t, const double* y) {
   std::copy(y, y + n_, y_.begin());
   f_(t_, y_.data(), f0_.data(), user_);
   ++nf_;
-  if (g_ && nroots_) g_(t_, y_.data(), g0_.data(), user_);
+  ++ctr_.resets;
+  since_reset_ = 0;
+  if (g_ && nroots_) {
+    g_(t_, y_.data(), g0_.data(), user_);
+    ++ctr_.root_evaluations;
+  }
   if (h_ <= 0) h_ = initial_step();
   tprev_ = t_;
   yprev_ = y_;
@@ -137,9 +142,15 @@ ErkStepper::Status ErkStepper::step() {
     double h = std::min(h_, tstop_ - t_);
     const bool to_stop = h >= tstop_ - t_;
     if (h < 1e-14 * std::max(1.0, std::fabs(t_))) return StepTooSmall;
+    const long nf_before = nf_;
     const double err = attempt(t_, y_.data(), f0_.data(), h, ynew_.data());
     const double fac = err > 0 ? 0.9 * std::pow(err, -expo) : 5.0;
-    if (err <= 1.0 && std::isfinite(err)) {
+    const bool accept = err <= 1.0 && std::isfinite(err);
+    const long used = nf_ - nf_before + (accept ? 1 : 0);
+    (accept ? ctr_.rhs_accepted : ctr_.rhs_rejected) += used;
+    if (since_reset_ < 2) ctr_.rhs_after_reset += used;
+    if (accept) {
+      ++since_reset_;
       // accept
       tprev_ = t_;
       yprev_.swap(y_);
@@ -159,6 +170,7 @@ ErkStepper::Status ErkStepper::step() {
 
   // Root detection over [tprev, t].
   g_(t_, y_.data(), g1_.data(), user_);
+  ++ctr_.root_evaluations;
   double troot = t_ + 1.0;
   int first = -1;
   for (std::size_t k = 0; k < nroots_; ++k) {
@@ -171,6 +183,7 @@ ErkStepper::Status ErkStepper::step() {
       const double tc = (gb != ga) ? tb - gb * (tb - ta) / (gb - ga) : 0.5 * (ta + tb);
       dense(tc, tmp_.data());
       g_(tc, tmp_.data(), gtmp_.data(), user_);
+      ++ctr_.root_evaluations;
       const double gc = gtmp_[k];
       if (gc == 0.0) {
         ta = tb = tc;
@@ -204,7 +217,9 @@ ErkStepper::Status ErkStepper::step() {
     for (std::size_t k = 0; k < nroots_; ++k) {
       const double a = g0_[k], b = g1_[k];
       if (a == 0.0 || !((a < 0) != (b < 0) || b == 0.0)) continue;
+      const long nf_before = nf_;
       const double tk = polish(k, tprev_, a, t_, b);
+      ctr_.rhs_root += nf_ - nf_before;
       if (tk < troot) {
         troot = tk;
         first = static_cast<int>(k);
@@ -212,6 +227,7 @@ ErkStepper::Status ErkStepper::step() {
     }
   }
   // Recompute the state at the root with a fresh RK step from the step's start.
+  const long nf_before_root = nf_;
   const double hroot = troot - tprev_;
   if (hroot > 0) {
     attempt(tprev_, yprev_.data(), fprev_.data(), hroot, ynew_.data());
@@ -222,7 +238,9 @@ ErkStepper::Status ErkStepper::step() {
   t_ = troot;
   f_(t_, y_.data(), f0_.data(), user_);  // keeps dense() consistent on [tprev, troot]
   ++nf_;
+  ctr_.rhs_root += nf_ - nf_before_root;
   g_(t_, y_.data(), g1_.data(), user_);
+  ++ctr_.root_evaluations;
   std::fill(found_.begin(), found_.end(), 0);
   found_[static_cast<std::size_t>(first)] = 1;
   for (std::size_t k = 0; k < nroots_; ++k) {
@@ -239,6 +257,7 @@ double ErkStepper::polish(std::size_t k, double ta, double ga, double tb, double
     if (!(tc > ta && tc < tb)) tc = 0.5 * (ta + tb);
     attempt(tprev_, yprev_.data(), fprev_.data(), tc - tprev_, ynew_.data());
     g_(tc, ynew_.data(), gtmp_.data(), user_);
+    ++ctr_.root_evaluations;
     const double gc = gtmp_[k];
     if (gc == 0.0) return tc;
     if ((gc < 0) == (gb < 0)) {

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "abuopt/core/sim_counters.hpp"
+
 namespace abuopt::detail {
 
 struct ButcherTable {
@@ -83,6 +85,8 @@ class ErkStepper {
   std::vector<double> g0_, g1_, gtmp_;
   std::vector<int> found_;
   long steps_ = 0, nf_ = 0;
+  SimCounters& ctr_;    // this thread's counters (sim_counters.hpp)
+  int since_reset_ = 0;  // accepted steps since the last reset
 };
 
 }  // namespace abuopt::detail

@@ -32,6 +32,7 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/core/abu_model.hpp"
+#include "abuopt/core/sim_counters.hpp"
 #include "abuopt/core/simulation_config.hpp"
 #include "integrator.hpp"
 #include "sim_run_state.hpp"
@@ -152,6 +153,7 @@ class Run {
   }
   void choose_initial_modes();
   bool handle_event(double t);  // false: a guard ended the run (status set)
+  void count_event_kinds() const;  // into sim_counters(), from rinfo_ and the modes before the event
   bool count_event(double t);
   void track_all_stuck(double t) {
     if (all_stuck(rs_, y_.data())) {
@@ -255,7 +257,23 @@ void Run::record(double tt, const std::vector<double>& yy) {
 }
 
 // A root of the stick/slip functions at t: re-choose the modes, count the event, apply the guards.
+void Run::count_event_kinds() const {
+  SimCounters& c = sim_counters();
+  for (std::size_t i = 0; i < rs_.n; ++i) {
+    const bool stuck = rs_.modes[i] == BallMode::Stick;
+    if (stuck) {
+      c.stick_to_slip += (rinfo_[2 * i] != 0) + (rinfo_[2 * i + 1] != 0);
+    } else if (rinfo_[2 * i] != 0) {
+      // with contact, the first function of a slipping cluster's inner ball is its contact force
+      const bool inner = rs_.contact && rs_.cs.clusters.groups[static_cast<std::size_t>(rs_.cs.group_of[i])].back() != i;
+      ++(inner ? c.contact_open : c.slip_stop);
+    }
+  }
+  for (std::size_t k = 2 * rs_.n; k < rinfo_.size(); ++k) c.gap_closed += rinfo_[k] != 0;
+}
+
 bool Run::handle_event(double t) {
+  count_event_kinds();
   // A slipping ball whose speed reached zero may stick or reverse: a candidate. A stuck ball
   // whose friction margin reached zero leaves stick in the direction of the force needed to
   // hold it (the net force); the others are re-chosen consistently with that.
