@@ -73,6 +73,8 @@ void run_cycle(benchmark::State& state, const abuopt::Simulator& sim, bool detai
   state.counters["rhs_root"] = per_run(c.rhs_root);
   state.counters["rhs_after_reset"] = per_run(c.rhs_after_reset);
   state.counters["root_evals"] = per_run(c.root_evaluations);
+  state.counters["polishes"] = per_run(c.polishes);
+  state.counters["polish_steps"] = per_run(c.polish_steps);
 }
 
 // Args: -log10(rtol), stuck integrator (0 rk, 1 exact).

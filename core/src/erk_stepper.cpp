@@ -1,5 +1,7 @@
 #include "erk_stepper.hpp"
 
+#include "root_refine.hpp"
+
 #include <arkode/arkode_butcher.h>
 #include <arkode/arkode_butcher_erk.h>
 
@@ -56,6 +58,8 @@ ErkStepper::ErkStepper(ButcherTable table, std::size_t n, RhsFn f, RootFn g, std
   err_.resize(n);
   g0_.resize(nroots);
   g1_.resize(nroots);
+  groot_.resize(nroots);
+  hint_.resize(nroots);
   gtmp_.resize(nroots);
   found_.assign(nroots, 0);
 }
@@ -202,6 +206,7 @@ ErkStepper::Status ErkStepper::step() {
       }
     }
     const double tk = tb;  // on the far side of the crossing
+    hint_[k] = tk;
     if (tk < troot) {
       troot = tk;
       first = static_cast<int>(k);
@@ -212,17 +217,36 @@ ErkStepper::Status ErkStepper::step() {
     return t_ >= tstop_ ? StopReached : Ok;
   }
   if (polish_) {
-    // every function that crossed over the step, refined on the RK solution; earliest wins
-    troot = t_ + 1.0;
+    // The crossed functions refined on the RK solution, the earliest wins. In the order of their
+    // interpolated roots: once one is polished (troot), a later function needs polishing only if
+    // it has crossed by troot already (its sign at the state at troot), on [tprev, troot].
+    order_.clear();
     for (std::size_t k = 0; k < nroots_; ++k) {
       const double a = g0_[k], b = g1_[k];
-      if (a == 0.0 || !((a < 0) != (b < 0) || b == 0.0)) continue;
-      const long nf_before = nf_;
-      const double tk = polish(k, tprev_, a, t_, b);
-      ctr_.rhs_root += nf_ - nf_before;
-      if (tk < troot) {
+      if (a != 0.0 && ((a < 0) != (b < 0) || b == 0.0)) order_.push_back(k);
+    }
+    std::sort(order_.begin(), order_.end(), [&](std::size_t i, std::size_t j) { return hint_[i] < hint_[j]; });
+    troot = t_;
+    first = -1;
+    for (std::size_t k : order_) {
+      double tb = t_, gb = g1_[k];
+      if (first >= 0) {
+        gb = groot_[k];
+        // not crossed by troot: its root is later; exactly zero there: a root at troot (found_)
+        if (gb == 0.0 || (g0_[k] < 0) == (gb < 0)) continue;
+        tb = troot;
+      }
+      const double tk = polish(k, tprev_, g0_[k], tb, gb, hint_[k]);
+      if (first < 0 || tk < troot) {
         troot = tk;
         first = static_cast<int>(k);
+        if (order_.size() > 1) {  // the signs at troot, for the functions still to come
+          const long nf_before = nf_;
+          attempt(tprev_, yprev_.data(), fprev_.data(), troot - tprev_, ynew_.data());
+          ctr_.rhs_root += nf_ - nf_before;
+          g_(troot, ynew_.data(), groot_.data(), user_);
+          ++ctr_.root_evaluations;
+        }
       }
     }
   }
@@ -250,29 +274,20 @@ ErkStepper::Status ErkStepper::step() {
   return Root;  // the caller resets the stepper at the root
 }
 
-double ErkStepper::polish(std::size_t k, double ta, double ga, double tb, double gb) {
-  int side = 0;
-  for (int it = 0; it < 100 && std::fabs(tb - ta) > 4e-16 * std::max(1.0, std::fabs(tb)); ++it) {
-    double tc = (gb != ga) ? tb - gb * (tb - ta) / (gb - ga) : 0.5 * (ta + tb);
-    if (!(tc > ta && tc < tb)) tc = 0.5 * (ta + tb);
+double ErkStepper::polish(std::size_t k, double ta, double ga, double tb, double gb, double hint) {
+  ++ctr_.polishes;
+  auto g = [&](double tc) {
+    ++ctr_.polish_steps;
+    const long nf_before = nf_;
     attempt(tprev_, yprev_.data(), fprev_.data(), tc - tprev_, ynew_.data());
+    ctr_.rhs_root += nf_ - nf_before;
     g_(tc, ynew_.data(), gtmp_.data(), user_);
     ++ctr_.root_evaluations;
-    const double gc = gtmp_[k];
-    if (gc == 0.0) return tc;
-    if ((gc < 0) == (gb < 0)) {
-      tb = tc;
-      gb = gc;
-      if (side == -1) ga *= 0.5;
-      side = -1;
-    } else {
-      ta = tc;
-      ga = gc;
-      if (side == 1) gb *= 0.5;
-      side = 1;
-    }
-  }
-  return tb;  // on the far side of the crossing
+    return gtmp_[k];
+  };
+  // the interpolant's root first, with a closing point 1e-6 of the step beyond it (the
+  // interpolant's error in the root time is far smaller)
+  return refine_crossing(g, ta, ga, tb, gb, 4e-16 * std::max(1.0, std::fabs(tb)), hint, 1e-6 * (tb - ta));
 }
 
 void ErkStepper::dense(double t, double* out) const {

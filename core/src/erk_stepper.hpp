@@ -62,7 +62,8 @@ class ErkStepper {
   // One RK step of size h from (t0, y0, f0): high-order result into yout, error norm returned.
   double attempt(double t0, const double* y0, const double* f0, double h, double* yout);
   // Root of g_k in [ta, tb] (g_k(ta) = ga, g_k(tb) = gb of opposite signs) on RK steps from tprev.
-  double polish(std::size_t k, double ta, double ga, double tb, double gb);
+  // hint: the root on the interpolant (the first trial point).
+  double polish(std::size_t k, double ta, double ga, double tb, double gb, double hint);
   bool polish_ = false;
   double initial_step() ;
 
@@ -82,7 +83,8 @@ class ErkStepper {
   long max_steps_;
   double t_ = 0, h_ = 0, tstop_ = 1e300, tprev_ = 0;
   std::vector<double> y_, f0_, yprev_, fprev_, ynew_, k_, tmp_, err_;
-  std::vector<double> g0_, g1_, gtmp_;
+  std::vector<double> g0_, g1_, gtmp_, groot_, hint_;
+  std::vector<std::size_t> order_;
   std::vector<int> found_;
   long steps_ = 0, nf_ = 0;
   SimCounters& ctr_;    // this thread's counters (sim_counters.hpp)

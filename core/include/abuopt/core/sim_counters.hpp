@@ -18,6 +18,8 @@ struct SimCounters {
   long rhs_root = 0;          // the state at a root (and the polished roots' iterations)
   long rhs_after_reset = 0;   // of rhs_accepted + rhs_rejected: the first two steps after a restart
   long root_evaluations = 0;  // evaluations of the root functions (each costs about one RHS)
+  long polishes = 0;          // roots refined on the Runge-Kutta solution (hard contact)
+  long polish_steps = 0;      // the Runge-Kutta steps those refinements took
 };
 
 SimCounters& sim_counters();
