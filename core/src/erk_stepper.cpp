@@ -60,6 +60,10 @@ ErkStepper::ErkStepper(ButcherTable table, std::size_t n, RhsFn f, RootFn g, std
   g1_.resize(nroots);
   groot_.resize(nroots);
   hint_.resize(nroots);
+  gd0_.assign(nroots, 0.0);
+  gd1_.assign(nroots, 0.0);
+  bt_.resize(nroots);
+  bg_.resize(nroots);
   gtmp_.resize(nroots);
   found_.assign(nroots, 0);
 }
@@ -74,6 +78,7 @@ void ErkStepper::reset(double t, const double* y) {
   if (g_ && nroots_) {
     g_(t_, y_.data(), g0_.data(), user_);
     ++ctr_.root_evaluations;
+    if (gd_) gd_(t_, y_.data(), gd0_.data(), user_);
   }
   if (h_ <= 0) h_ = initial_step();
   tprev_ = t_;
@@ -175,13 +180,18 @@ ErkStepper::Status ErkStepper::step() {
   // Root detection over [tprev, t].
   g_(t_, y_.data(), g1_.data(), user_);
   ++ctr_.root_evaluations;
+  for (std::size_t k = 0; k < nroots_; ++k) {
+    bt_[k] = t_;
+    bg_[k] = g1_[k];
+  }
+  if (gd_) find_dips();
   double troot = t_ + 1.0;
   int first = -1;
   for (std::size_t k = 0; k < nroots_; ++k) {
-    const double a = g0_[k], b = g1_[k];
+    const double a = g0_[k], b = bg_[k];
     if (a == 0.0 || !((a < 0) != (b < 0) || b == 0.0)) continue;
     // Illinois on the Hermite interpolant.
-    double ta = tprev_, tb = t_, ga = a, gb = b;
+    double ta = tprev_, tb = bt_[k], ga = a, gb = b;
     int side = 0;
     for (int it = 0; it < 60 && std::fabs(tb - ta) > 1e-14 * std::max(1.0, std::fabs(t_)); ++it) {
       const double tc = (gb != ga) ? tb - gb * (tb - ta) / (gb - ga) : 0.5 * (ta + tb);
@@ -214,6 +224,7 @@ ErkStepper::Status ErkStepper::step() {
   }
   if (first < 0) {
     g0_.swap(g1_);
+    gd0_.swap(gd1_);
     return t_ >= tstop_ ? StopReached : Ok;
   }
   if (polish_) {
@@ -222,19 +233,19 @@ ErkStepper::Status ErkStepper::step() {
     // it has crossed by troot already (its sign at the state at troot), on [tprev, troot].
     order_.clear();
     for (std::size_t k = 0; k < nroots_; ++k) {
-      const double a = g0_[k], b = g1_[k];
+      const double a = g0_[k], b = bg_[k];
       if (a != 0.0 && ((a < 0) != (b < 0) || b == 0.0)) order_.push_back(k);
     }
     std::sort(order_.begin(), order_.end(), [&](std::size_t i, std::size_t j) { return hint_[i] < hint_[j]; });
     troot = t_;
     first = -1;
     for (std::size_t k : order_) {
-      double tb = t_, gb = g1_[k];
+      double tb = bt_[k], gb = bg_[k];
       if (first >= 0) {
         gb = groot_[k];
         // not crossed by troot: its root is later; exactly zero there: a root at troot (found_)
         if (gb == 0.0 || (g0_[k] < 0) == (gb < 0)) continue;
-        tb = troot;
+        tb = std::min(tb, troot);
       }
       const double tk = polish(k, tprev_, g0_[k], tb, gb, hint_[k]);
       if (first < 0 || tk < troot) {
@@ -272,6 +283,37 @@ ErkStepper::Status ErkStepper::step() {
     if (a != 0.0 && ((a < 0) != (b < 0) || b == 0.0)) found_[k] = 1;
   }
   return Root;  // the caller resets the stepper at the root
+}
+
+void ErkStepper::find_dips() {
+  gd_(t_, y_.data(), gd1_.data(), user_);
+  const double h = t_ - tprev_;
+  for (std::size_t k = 0; k < nroots_; ++k) {
+    const double g0 = g0_[k], g1 = g1_[k];
+    if (g0 == 0.0 || g1 == 0.0 || (g0 < 0) != (g1 < 0)) continue;  // no dip: zero or a sign change
+    const double s = g0 < 0 ? -1.0 : 1.0;
+    if (!(s * gd0_[k] < 0 && s * gd1_[k] > 0)) continue;  // not towards zero, then away
+    // the interpolant g0 + a1 u + a2 u^2 + a3 u^3 on u in [0, 1]; its slope changes sign once
+    const double a1 = h * gd0_[k], a2 = 3 * (g1 - g0) - h * (2 * gd0_[k] + gd1_[k]), a3 = 2 * (g0 - g1) + h * (gd0_[k] + gd1_[k]);
+    double lo = 0, hi = 1;
+    for (int it = 0; it < 60; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      if (s * (a1 + mid * (2 * a2 + 3 * a3 * mid)) < 0) lo = mid; else hi = mid;
+    }
+    const double u = 0.5 * (lo + hi);
+    if (s * (g0 + u * (a1 + u * (a2 + u * a3))) > 0) continue;  // the interpolant stays on its side
+    const double tm = tprev_ + u * h;
+    if (!(tm > tprev_ && tm < t_)) continue;
+    const long nf_before = nf_;
+    attempt(tprev_, yprev_.data(), fprev_.data(), tm - tprev_, ynew_.data());  // on the RK solution
+    ctr_.rhs_root += nf_ - nf_before;
+    g_(tm, ynew_.data(), gtmp_.data(), user_);
+    ++ctr_.root_evaluations;
+    if (s * gtmp_[k] > 0) continue;
+    ++ctr_.dips;
+    bt_[k] = tm;
+    bg_[k] = gtmp_[k];
+  }
 }
 
 double ErkStepper::polish(std::size_t k, double ta, double ga, double tb, double gb, double hint) {

@@ -93,6 +93,16 @@ void roots_contact(double tbar, const double* y, double* g, void* user) {
     g[2 * rs.n + k] = cs.closed[k] ? 1.0 : cs.geo.gap(y + lay.beta(0), k) + cs.off_gap[k];
 }
 
+void root_rates_contact(double, const double* y, double* gd, void* user) {
+  const auto& rs = *static_cast<const RunState*>(user);
+  const StateLayout& lay = rs.lay();
+  const ContactState& cs = rs.cs;
+  std::fill(gd, gd + 2 * rs.n, 0.0);
+  for (std::size_t k = 0; k < cs.geo.pairs(); ++k)
+    gd[2 * rs.n + k] = cs.closed[k] ? 0.0
+                                    : y[lay.beta_dot(cs.geo.order[(k + 1) % rs.n])] - y[lay.beta_dot(cs.geo.order[k])];
+}
+
 // Functions that start at or below zero by rounding are shifted so their later crossing is seen.
 void set_contact_root_offsets(RunState& rs, double tbar, const double* y) {
   const StateLayout& lay = rs.lay();

@@ -12,8 +12,8 @@
 // root the modes of all balls are chosen together (AbuModel::choose_modes) and the integrator is
 // reset. After the profile ends with every ball stuck (ideal motor), the table motion is linear
 // and time-invariant; if a bound on its transient proves that no stick margin can reach zero, the
-// run is finished in closed form (closed_form_tail). While every ball is stuck (ideal motor, no
-// contact), the default stuck integrator propagates the table exactly instead of stepping
+// run is finished in closed form (closed_form_tail). While every ball is stuck (ideal motor), the
+// default stuck integrator propagates the table exactly instead of stepping
 // (stuck_propagator.hpp, docs/stuck_propagator.md); the stepper restarts at the next event.
 //
 // The parts: sim_rhs.cpp (right-hand side and root functions), closed_form_tail.cpp,
@@ -71,10 +71,8 @@ Simulator::Simulator(SimulationSetup setup) : setup_(std::move(setup)) {
   // The exact stuck-phase propagator: its forcing integrals depend only on the profile and the
   // table, so they are computed once here and shared by every run.
   const NondimParameters nd = NondimParameters::from(setup_.abu);
-  // (Not with hard contact between two or more balls: such runs keep the Runge-Kutta path.)
-  const bool contact = setup_.abu.ball_contact == BallContact::Hard && setup_.abu.balls.size() >= 2;
   if (o.stuck_integrator == StuckIntegrator::Exact && o.method == FrictionMethod::EventDriven &&
-      setup_.motor.kind == MotorKind::Ideal && !contact && StuckForcingTable::supports(nd))
+      setup_.motor.kind == MotorKind::Ideal && StuckForcingTable::supports(nd))
     stuck_table_ = std::make_shared<const StuckForcingTable>(setup_.profile, nd, end_time_s() * nd.omega_n);
 }
 
@@ -136,11 +134,9 @@ class Run {
     }
     choose_initial_modes();
     // The exact stuck-phase propagator needs the table of this run's omega_n and bbar (an
-    // imbalance-mass override changes both: such runs keep the Runge-Kutta path), no trajectory,
-    // and no ball contact (not validated with contact yet: docs/stuck_propagator.md section 5).
-    if (stuck_table && !rs_.pi_motor && event_driven_ && !(trajectory_ && traj_dt_ > 0) && !rs_.contact &&
-        stuck_table->matches(rs_.nd))
-      stuck_.emplace(*stuck_table, rs_, roots_plain);
+    // imbalance-mass override changes both: such runs keep the Runge-Kutta path) and no trajectory.
+    if (stuck_table && !rs_.pi_motor && event_driven_ && !(trajectory_ && traj_dt_ > 0) && stuck_table->matches(rs_.nd))
+      stuck_.emplace(*stuck_table, rs_, rs_.contact ? roots_contact : roots_plain);
   }
 
   RunOutcome execute();

@@ -20,6 +20,7 @@ struct SimCounters {
   long root_evaluations = 0;  // evaluations of the root functions (each costs about one RHS)
   long polishes = 0;          // roots refined on the Runge-Kutta solution (hard contact)
   long polish_steps = 0;      // the Runge-Kutta steps those refinements took
+  long dips = 0;              // hard contact: gaps that closed and opened again inside one step
 };
 
 SimCounters& sim_counters();
