@@ -73,7 +73,7 @@ Simulator::Simulator(SimulationSetup setup) : setup_(std::move(setup)) {
   const NondimParameters nd = NondimParameters::from(setup_.abu);
   if (o.stuck_integrator == StuckIntegrator::Exact && o.method == FrictionMethod::EventDriven &&
       setup_.motor.kind == MotorKind::Ideal && StuckForcingTable::supports(nd))
-    stuck_table_ = std::make_shared<const StuckForcingTable>(setup_.profile, nd, end_time_s() * nd.omega_n);
+    stuck_table_ = StuckForcingTable::shared(setup_.profile, nd, end_time_s() * nd.omega_n);
 }
 
 Simulator::~Simulator() = default;
