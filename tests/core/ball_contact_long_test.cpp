@@ -49,7 +49,9 @@ TEST(BallContactLong, NoFinalStateOverlapsIn1024RandomStartsFourBallsBothStuckIn
     for (int k = 0; k < 1024; ++k) {
       const RunOutcome o = sim.run({u(rng), u(rng), u(rng), u(rng)});
       failed += !o.ok();
-      if (!o.ok()) EXPECT_EQ(o.status, RunStatus::ChatterLimit) << o.message;
+      if (!o.ok()) {
+        EXPECT_EQ(o.status, RunStatus::ChatterLimit) << o.message;
+      }
       overlaps += min_contact_clearance(s.abu, o.beta_final) < -1e-12;
     }
     EXPECT_EQ(overlaps, 0) << to_string(stuck);
