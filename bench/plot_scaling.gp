@@ -4,11 +4,11 @@
 #   gnuplot plot_scaling.gp            -> scaling.png
 #   gnuplot -e "term='dumb'" plot_scaling.gp   (text, as in docs/performance.md)
 if (!exists("term")) term = 'pngcairo'
-if (term eq 'dumb') { set terminal dumb size 100,28 } else { set terminal pngcairo size 1100,450; set output 'scaling.png' }
+if (term eq 'dumb') { set terminal dumb size 100,28 } else { set terminal pngcairo size 1100,560; set output 'scaling.png' }
 set multiplot layout 1,2
 set logscale y
 set grid
-set key top right
+set key below
 set ylabel 'runs per second (1 / CPU per run)'
 set xlabel 'number of balls (final profile)'
 set title 'cost against ball count'

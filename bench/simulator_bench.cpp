@@ -45,7 +45,7 @@ std::vector<std::vector<double>> fixed_initial_conditions(std::size_t balls = 2)
 void run_cycle(benchmark::State& state, const abuopt::Simulator& sim, bool detail = false) {
   const auto ics = fixed_initial_conditions(sim.ball_count());
   std::size_t k = 0;
-  double rhs = 0, steps = 0, events = 0, impacts = 0, runs = 0;
+  double rhs = 0, steps = 0, events = 0, impacts = 0, failed = 0, runs = 0;
   abuopt::sim_counters() = {};
   for (auto _ : state) {
     const auto o = sim.run(ics[k++ % ics.size()]);
@@ -54,6 +54,7 @@ void run_cycle(benchmark::State& state, const abuopt::Simulator& sim, bool detai
     steps += static_cast<double>(o.steps);
     events += static_cast<double>(o.events);
     impacts += static_cast<double>(o.impacts);
+    failed += o.ok() ? 0 : 1;
     runs += 1;
   }
   state.counters["rhs_per_run"] = rhs / runs;
@@ -63,6 +64,7 @@ void run_cycle(benchmark::State& state, const abuopt::Simulator& sim, bool detai
   const abuopt::SimCounters& c = abuopt::sim_counters();
   const auto per_run = [&](long v) { return static_cast<double>(v) / runs; };
   state.counters["impacts_per_run"] = impacts / runs;
+  state.counters["failed_share"] = failed / runs;  // runs that ended early (chatter limit, ...)
   state.counters["ev_stick_slip"] = per_run(c.stick_to_slip);
   state.counters["ev_slip_stop"] = per_run(c.slip_stop);
   state.counters["ev_gap"] = per_run(c.gap_closed);
