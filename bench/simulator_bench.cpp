@@ -8,6 +8,7 @@
 #include <random>
 
 #include "abuopt/core/abu_model.hpp"
+#include "abuopt/core/sim_counters.hpp"
 #include "abuopt/core/simulator.hpp"
 
 namespace {
@@ -39,22 +40,44 @@ std::vector<std::vector<double>> fixed_initial_conditions(std::size_t balls = 2)
   return v;
 }
 
-// Runs the simulator over the fixed starts; counters per run.
-void run_cycle(benchmark::State& state, const abuopt::Simulator& sim) {
+// Runs the simulator over the fixed starts; counters per run. With `detail`, also the events by
+// kind (root functions that crossed) and the right-hand sides by purpose (sim_counters.hpp).
+void run_cycle(benchmark::State& state, const abuopt::Simulator& sim, bool detail = false) {
   const auto ics = fixed_initial_conditions(sim.ball_count());
   std::size_t k = 0;
-  double rhs = 0, steps = 0, events = 0, runs = 0;
+  double rhs = 0, steps = 0, events = 0, impacts = 0, failed = 0, runs = 0;
+  abuopt::sim_counters() = {};
   for (auto _ : state) {
     const auto o = sim.run(ics[k++ % ics.size()]);
     benchmark::DoNotOptimize(o.residual_imbalance_kgm);
     rhs += static_cast<double>(o.rhs_evaluations);
     steps += static_cast<double>(o.steps);
     events += static_cast<double>(o.events);
+    impacts += static_cast<double>(o.impacts);
+    failed += o.ok() ? 0 : 1;
     runs += 1;
   }
   state.counters["rhs_per_run"] = rhs / runs;
   state.counters["steps_per_run"] = steps / runs;
   state.counters["events_per_run"] = events / runs;
+  if (!detail) return;
+  const abuopt::SimCounters& c = abuopt::sim_counters();
+  const auto per_run = [&](long v) { return static_cast<double>(v) / runs; };
+  state.counters["impacts_per_run"] = impacts / runs;
+  state.counters["failed_share"] = failed / runs;  // runs that ended early (chatter limit, ...)
+  state.counters["ev_stick_slip"] = per_run(c.stick_to_slip);
+  state.counters["ev_slip_stop"] = per_run(c.slip_stop);
+  state.counters["ev_gap"] = per_run(c.gap_closed);
+  state.counters["ev_contact_open"] = per_run(c.contact_open);
+  state.counters["resets"] = per_run(c.resets);
+  state.counters["rhs_acc"] = per_run(c.rhs_accepted);
+  state.counters["rhs_rej"] = per_run(c.rhs_rejected);
+  state.counters["rhs_root"] = per_run(c.rhs_root);
+  state.counters["rhs_after_reset"] = per_run(c.rhs_after_reset);
+  state.counters["root_evals"] = per_run(c.root_evaluations);
+  state.counters["polishes"] = per_run(c.polishes);
+  state.counters["polish_steps"] = per_run(c.polish_steps);
+  state.counters["dips"] = per_run(c.dips);
 }
 
 // Args: -log10(rtol), stuck integrator (0 rk, 1 exact).
@@ -80,16 +103,30 @@ BENCHMARK(BM_Tolerance)
     ->Unit(benchmark::kMillisecond)
     ->Iterations(64);
 
-// Cost against the number of balls (identical balls of the report, no contact), final profile.
+// Cost against the number of balls N, final profile, in four configurations (arg `cfg`):
+//   0  identical balls of the report (1.4e-4 kg, 3 mm), no contact
+//   1  identical balls, hard contact
+//   2  equal total ball mass (2.8e-4 kg, two report balls; the study's formulation 4): m = 2.8e-4 / N,
+//      same material, d = 3 mm (2 / N)^(1/3); no contact
+//   3  equal total ball mass, hard contact
 void BM_BallCount(benchmark::State& state) {
   abuopt::SimulationSetup s = final_profile(abuopt::IntegratorBackend::Native, 1e-6, stuck_arg(state.range(1)));
-  s.abu.balls.assign(static_cast<std::size_t>(state.range(0)), abuopt::Ball{});
+  const auto n = static_cast<std::size_t>(state.range(0));
+  const std::int64_t cfg = state.range(2);
+  abuopt::Ball b;
+  if (cfg >= 2) {
+    b.mass_kg = 2.8e-4 / static_cast<double>(n);
+    b.diameter_m = 3.0e-3 * std::cbrt(2.0 / static_cast<double>(n));
+  }
+  s.abu.balls.assign(n, b);
+  if (cfg == 1 || cfg == 3) s.abu.ball_contact = abuopt::BallContact::Hard;
   abuopt::Simulator sim(s);
-  run_cycle(state, sim);
+  run_cycle(state, sim, true);
 }
 BENCHMARK(BM_BallCount)
-    ->ArgsProduct({{2, 3, 4, 6, 9}, {0, 1}})
-    ->ArgNames({"balls", "exact"})
+    ->ArgsProduct({{2, 3, 4, 6, 9}, {0, 1}, {0}})
+    ->ArgsProduct({{2, 3, 4, 6, 9}, {1}, {1, 2, 3}})
+    ->ArgNames({"balls", "exact", "cfg"})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(64);
 
@@ -108,15 +145,28 @@ BENCHMARK(BM_ProfileLength)
     ->Unit(benchmark::kMillisecond)
     ->Iterations(64);
 
-// Building a Simulator: with the exact stuck integrator this computes the forcing table once.
+// Building a Simulator: with the exact stuck integrator this computes the forcing table, or takes
+// it from the process-wide cache of recent tables (StuckForcingTable::shared). cached:0 makes every
+// iteration's profile new (the last duration moves by 1 ns), so the table is built each time.
 void BM_SimulatorSetup(benchmark::State& state) {
-  const auto s = final_profile(abuopt::IntegratorBackend::Native, 1e-6, stuck_arg(state.range(0)));
+  auto s = final_profile(abuopt::IntegratorBackend::Native, 1e-6, stuck_arg(state.range(0)));
+  std::vector<abuopt::InclinedSineSegment> seg = s.profile.segments();
+  long k = 0;
   for (auto _ : state) {
+    if (state.range(1) == 0) {
+      seg.back().duration_s = 8.0 + 1e-9 * static_cast<double>(++k);
+      s.profile = abuopt::StartupProfile(seg);
+    }
     abuopt::Simulator sim(s);
     benchmark::DoNotOptimize(&sim);
   }
 }
-BENCHMARK(BM_SimulatorSetup)->Arg(0)->Arg(1)->ArgName("exact")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SimulatorSetup)
+    ->Args({0, 1})
+    ->Args({1, 0})
+    ->Args({1, 1})
+    ->ArgNames({"exact", "cached"})
+    ->Unit(benchmark::kMillisecond);
 
 // Ball contact: the same 16 starts (mapped onto the feasible set by the simulator when they
 // overlap), contact none vs hard, in one program run so the ratio is measured under one load.

@@ -40,11 +40,7 @@ void AbuModel::evaluate(const double* y, double W, double Wp, const BallMode* mo
   for (std::size_t i = 0; i < n; ++i) {
     const double bdi = y[layout_.beta_dot(i)];
     const double beta = y[layout_.beta(i)];
-    if (beta != out.sc_beta[i]) {
-      out.s[i] = std::sin(beta);
-      out.c[i] = std::cos(beta);
-      out.sc_beta[i] = beta;
-    }
+    out.sincos_at(i, beta);
     const double s = out.s[i], c = out.c[i];
     const double m = nd_.mbar[i];
     const double w = bdi + W;

@@ -19,11 +19,7 @@ void AbuModel::evaluate_clusters(const double* y, double W, double Wp, const Bal
   for (std::size_t i = 0; i < n; ++i) {
     const double bdi = y[layout_.beta_dot(i)];
     const double beta = y[layout_.beta(i)];
-    if (beta != out.sc_beta[i]) {
-      out.s[i] = std::sin(beta);
-      out.c[i] = std::cos(beta);
-      out.sc_beta[i] = beta;
-    }
+    out.sincos_at(i, beta);
     const double s = out.s[i], c = out.c[i], m = nd_.mbar[i], w = bdi + W;
     hx += -Wp * m * s - m * w * w * c;
     hy += Wp * m * c - m * w * w * s;

@@ -1,5 +1,7 @@
 #include "erk_stepper.hpp"
 
+#include "root_refine.hpp"
+
 #include <arkode/arkode_butcher.h>
 #include <arkode/arkode_butcher_erk.h>
 
@@ -33,7 +35,7 @@ ButcherTable ButcherTable::from_arkode(const std::string& name) {
 ErkStepper::ErkStepper(ButcherTable table, std::size_t n, RhsFn f, RootFn g, std::size_t nroots, void* user,
                        double rtol, double atol, long max_steps)
     : tab_(std::move(table)), n_(n), nroots_(nroots), f_(f), g_(g), user_(user), rtol_(rtol), atol_(atol),
-      max_steps_(max_steps) {
+      max_steps_(max_steps), ctr_(sim_counters()) {
   const std::size_t s = static_cast<std::size_t>(tab_.stages);
   a_terms_.resize(s);
   for (int i = 0; i < tab_.stages; ++i)
@@ -56,6 +58,12 @@ ErkStepper::ErkStepper(ButcherTable table, std::size_t n, RhsFn f, RootFn g, std
   err_.resize(n);
   g0_.resize(nroots);
   g1_.resize(nroots);
+  groot_.resize(nroots);
+  hint_.resize(nroots);
+  gd0_.assign(nroots, 0.0);
+  gd1_.assign(nroots, 0.0);
+  bt_.resize(nroots);
+  bg_.resize(nroots);
   gtmp_.resize(nroots);
   found_.assign(nroots, 0);
 }
@@ -65,7 +73,13 @@ void ErkStepper::reset(double t, const double* y) {
   std::copy(y, y + n_, y_.begin());
   f_(t_, y_.data(), f0_.data(), user_);
   ++nf_;
-  if (g_ && nroots_) g_(t_, y_.data(), g0_.data(), user_);
+  ++ctr_.resets;
+  since_reset_ = 0;
+  if (g_ && nroots_) {
+    g_(t_, y_.data(), g0_.data(), user_);
+    ++ctr_.root_evaluations;
+    if (gd_) gd_(t_, y_.data(), gd0_.data(), user_);
+  }
   if (h_ <= 0) h_ = initial_step();
   tprev_ = t_;
   yprev_ = y_;
@@ -137,9 +151,15 @@ ErkStepper::Status ErkStepper::step() {
     double h = std::min(h_, tstop_ - t_);
     const bool to_stop = h >= tstop_ - t_;
     if (h < 1e-14 * std::max(1.0, std::fabs(t_))) return StepTooSmall;
+    const long nf_before = nf_;
     const double err = attempt(t_, y_.data(), f0_.data(), h, ynew_.data());
     const double fac = err > 0 ? 0.9 * std::pow(err, -expo) : 5.0;
-    if (err <= 1.0 && std::isfinite(err)) {
+    const bool accept = err <= 1.0 && std::isfinite(err);
+    const long used = nf_ - nf_before + (accept ? 1 : 0);
+    (accept ? ctr_.rhs_accepted : ctr_.rhs_rejected) += used;
+    if (since_reset_ < 2) ctr_.rhs_after_reset += used;
+    if (accept) {
+      ++since_reset_;
       // accept
       tprev_ = t_;
       yprev_.swap(y_);
@@ -159,18 +179,25 @@ ErkStepper::Status ErkStepper::step() {
 
   // Root detection over [tprev, t].
   g_(t_, y_.data(), g1_.data(), user_);
+  ++ctr_.root_evaluations;
+  for (std::size_t k = 0; k < nroots_; ++k) {
+    bt_[k] = t_;
+    bg_[k] = g1_[k];
+  }
+  if (gd_) find_dips();
   double troot = t_ + 1.0;
   int first = -1;
   for (std::size_t k = 0; k < nroots_; ++k) {
-    const double a = g0_[k], b = g1_[k];
+    const double a = g0_[k], b = bg_[k];
     if (a == 0.0 || !((a < 0) != (b < 0) || b == 0.0)) continue;
     // Illinois on the Hermite interpolant.
-    double ta = tprev_, tb = t_, ga = a, gb = b;
+    double ta = tprev_, tb = bt_[k], ga = a, gb = b;
     int side = 0;
     for (int it = 0; it < 60 && std::fabs(tb - ta) > 1e-14 * std::max(1.0, std::fabs(t_)); ++it) {
       const double tc = (gb != ga) ? tb - gb * (tb - ta) / (gb - ga) : 0.5 * (ta + tb);
       dense(tc, tmp_.data());
       g_(tc, tmp_.data(), gtmp_.data(), user_);
+      ++ctr_.root_evaluations;
       const double gc = gtmp_[k];
       if (gc == 0.0) {
         ta = tb = tc;
@@ -189,6 +216,7 @@ ErkStepper::Status ErkStepper::step() {
       }
     }
     const double tk = tb;  // on the far side of the crossing
+    hint_[k] = tk;
     if (tk < troot) {
       troot = tk;
       first = static_cast<int>(k);
@@ -196,22 +224,45 @@ ErkStepper::Status ErkStepper::step() {
   }
   if (first < 0) {
     g0_.swap(g1_);
+    gd0_.swap(gd1_);
     return t_ >= tstop_ ? StopReached : Ok;
   }
   if (polish_) {
-    // every function that crossed over the step, refined on the RK solution; earliest wins
-    troot = t_ + 1.0;
+    // The crossed functions refined on the RK solution, the earliest wins. In the order of their
+    // interpolated roots: once one is polished (troot), a later function needs polishing only if
+    // it has crossed by troot already (its sign at the state at troot), on [tprev, troot].
+    order_.clear();
     for (std::size_t k = 0; k < nroots_; ++k) {
-      const double a = g0_[k], b = g1_[k];
-      if (a == 0.0 || !((a < 0) != (b < 0) || b == 0.0)) continue;
-      const double tk = polish(k, tprev_, a, t_, b);
-      if (tk < troot) {
+      const double a = g0_[k], b = bg_[k];
+      if (a != 0.0 && ((a < 0) != (b < 0) || b == 0.0)) order_.push_back(k);
+    }
+    std::sort(order_.begin(), order_.end(), [&](std::size_t i, std::size_t j) { return hint_[i] < hint_[j]; });
+    troot = t_;
+    first = -1;
+    for (std::size_t k : order_) {
+      double tb = bt_[k], gb = bg_[k];
+      if (first >= 0) {
+        gb = groot_[k];
+        // not crossed by troot: its root is later; exactly zero there: a root at troot (found_)
+        if (gb == 0.0 || (g0_[k] < 0) == (gb < 0)) continue;
+        tb = std::min(tb, troot);
+      }
+      const double tk = polish(k, tprev_, g0_[k], tb, gb, hint_[k]);
+      if (first < 0 || tk < troot) {
         troot = tk;
         first = static_cast<int>(k);
+        if (order_.size() > 1) {  // the signs at troot, for the functions still to come
+          const long nf_before = nf_;
+          attempt(tprev_, yprev_.data(), fprev_.data(), troot - tprev_, ynew_.data());
+          ctr_.rhs_root += nf_ - nf_before;
+          g_(troot, ynew_.data(), groot_.data(), user_);
+          ++ctr_.root_evaluations;
+        }
       }
     }
   }
   // Recompute the state at the root with a fresh RK step from the step's start.
+  const long nf_before_root = nf_;
   const double hroot = troot - tprev_;
   if (hroot > 0) {
     attempt(tprev_, yprev_.data(), fprev_.data(), hroot, ynew_.data());
@@ -222,7 +273,9 @@ ErkStepper::Status ErkStepper::step() {
   t_ = troot;
   f_(t_, y_.data(), f0_.data(), user_);  // keeps dense() consistent on [tprev, troot]
   ++nf_;
+  ctr_.rhs_root += nf_ - nf_before_root;
   g_(t_, y_.data(), g1_.data(), user_);
+  ++ctr_.root_evaluations;
   std::fill(found_.begin(), found_.end(), 0);
   found_[static_cast<std::size_t>(first)] = 1;
   for (std::size_t k = 0; k < nroots_; ++k) {
@@ -232,28 +285,51 @@ ErkStepper::Status ErkStepper::step() {
   return Root;  // the caller resets the stepper at the root
 }
 
-double ErkStepper::polish(std::size_t k, double ta, double ga, double tb, double gb) {
-  int side = 0;
-  for (int it = 0; it < 100 && std::fabs(tb - ta) > 4e-16 * std::max(1.0, std::fabs(tb)); ++it) {
-    double tc = (gb != ga) ? tb - gb * (tb - ta) / (gb - ga) : 0.5 * (ta + tb);
-    if (!(tc > ta && tc < tb)) tc = 0.5 * (ta + tb);
-    attempt(tprev_, yprev_.data(), fprev_.data(), tc - tprev_, ynew_.data());
-    g_(tc, ynew_.data(), gtmp_.data(), user_);
-    const double gc = gtmp_[k];
-    if (gc == 0.0) return tc;
-    if ((gc < 0) == (gb < 0)) {
-      tb = tc;
-      gb = gc;
-      if (side == -1) ga *= 0.5;
-      side = -1;
-    } else {
-      ta = tc;
-      ga = gc;
-      if (side == 1) gb *= 0.5;
-      side = 1;
+void ErkStepper::find_dips() {
+  gd_(t_, y_.data(), gd1_.data(), user_);
+  const double h = t_ - tprev_;
+  for (std::size_t k = 0; k < nroots_; ++k) {
+    const double g0 = g0_[k], g1 = g1_[k];
+    if (g0 == 0.0 || g1 == 0.0 || (g0 < 0) != (g1 < 0)) continue;  // no dip: zero or a sign change
+    const double s = g0 < 0 ? -1.0 : 1.0;
+    if (!(s * gd0_[k] < 0 && s * gd1_[k] > 0)) continue;  // not towards zero, then away
+    // the interpolant g0 + a1 u + a2 u^2 + a3 u^3 on u in [0, 1]; its slope changes sign once
+    const double a1 = h * gd0_[k], a2 = 3 * (g1 - g0) - h * (2 * gd0_[k] + gd1_[k]), a3 = 2 * (g0 - g1) + h * (gd0_[k] + gd1_[k]);
+    double lo = 0, hi = 1;
+    for (int it = 0; it < 60; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      if (s * (a1 + mid * (2 * a2 + 3 * a3 * mid)) < 0) lo = mid; else hi = mid;
     }
+    const double u = 0.5 * (lo + hi);
+    if (s * (g0 + u * (a1 + u * (a2 + u * a3))) > 0) continue;  // the interpolant stays on its side
+    const double tm = tprev_ + u * h;
+    if (!(tm > tprev_ && tm < t_)) continue;
+    const long nf_before = nf_;
+    attempt(tprev_, yprev_.data(), fprev_.data(), tm - tprev_, ynew_.data());  // on the RK solution
+    ctr_.rhs_root += nf_ - nf_before;
+    g_(tm, ynew_.data(), gtmp_.data(), user_);
+    ++ctr_.root_evaluations;
+    if (s * gtmp_[k] > 0) continue;
+    ++ctr_.dips;
+    bt_[k] = tm;
+    bg_[k] = gtmp_[k];
   }
-  return tb;  // on the far side of the crossing
+}
+
+double ErkStepper::polish(std::size_t k, double ta, double ga, double tb, double gb, double hint) {
+  ++ctr_.polishes;
+  auto g = [&](double tc) {
+    ++ctr_.polish_steps;
+    const long nf_before = nf_;
+    attempt(tprev_, yprev_.data(), fprev_.data(), tc - tprev_, ynew_.data());
+    ctr_.rhs_root += nf_ - nf_before;
+    g_(tc, ynew_.data(), gtmp_.data(), user_);
+    ++ctr_.root_evaluations;
+    return gtmp_[k];
+  };
+  // the interpolant's root first, with a closing point 1e-6 of the step beyond it (the
+  // interpolant's error in the root time is far smaller)
+  return refine_crossing(g, ta, ga, tb, gb, 4e-16 * std::max(1.0, std::fabs(tb)), hint, 1e-6 * (tb - ta));
 }
 
 void ErkStepper::dense(double t, double* out) const {

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "abuopt/core/sim_counters.hpp"
+
 namespace abuopt::detail {
 
 struct ButcherTable {
@@ -45,6 +47,13 @@ class ErkStepper {
   // method's accuracy instead of the interpolant's, and the earliest crossing wins. Off by
   // default (the no-contact model keeps its published numbers); on for hard ball contact.
   void set_polish_roots(bool on) { polish_ = on; }
+  // Rates dg_k/dt of the root functions where known (0 for the others). A function that moves
+  // towards zero at a step's start and away from it at the end may dip through zero and back
+  // inside the step (two crossings: no sign change at the ends). With rates, the stepper finds the
+  // extremum of such a function on the step's cubic Hermite interpolant, which is exact for
+  // functions linear in the state (ball-ball gaps), and if the extremum is across zero on the
+  // Runge-Kutta solution, the crossing before it is a root like any other.
+  void set_root_rates(RootFn gd) { gd_ = gd; }
   // Takes one accepted step (never past the stop time). On Root, t()/y() are at the earliest
   // root and roots_found()[k] != 0 marks the functions that crossed there.
   Status step();
@@ -60,7 +69,11 @@ class ErkStepper {
   // One RK step of size h from (t0, y0, f0): high-order result into yout, error norm returned.
   double attempt(double t0, const double* y0, const double* f0, double h, double* yout);
   // Root of g_k in [ta, tb] (g_k(ta) = ga, g_k(tb) = gb of opposite signs) on RK steps from tprev.
-  double polish(std::size_t k, double ta, double ga, double tb, double gb);
+  // With rates (gd_): functions that dip through zero and back inside the step get the bracket
+  // [tprev, their extremum] (bt_, bg_).
+  void find_dips();
+  // hint: the root on the interpolant (the first trial point).
+  double polish(std::size_t k, double ta, double ga, double tb, double gb, double hint);
   bool polish_ = false;
   double initial_step() ;
 
@@ -80,9 +93,15 @@ class ErkStepper {
   long max_steps_;
   double t_ = 0, h_ = 0, tstop_ = 1e300, tprev_ = 0;
   std::vector<double> y_, f0_, yprev_, fprev_, ynew_, k_, tmp_, err_;
-  std::vector<double> g0_, g1_, gtmp_;
+  std::vector<double> g0_, g1_, gtmp_, groot_, hint_;
+  RootFn gd_ = nullptr;
+  std::vector<double> gd0_, gd1_;  // root function rates at the step's ends (with gd_)
+  std::vector<double> bt_, bg_;    // per function: the end of its bracket [tprev, bt] and g there
+  std::vector<std::size_t> order_;
   std::vector<int> found_;
   long steps_ = 0, nf_ = 0;
+  SimCounters& ctr_;    // this thread's counters (sim_counters.hpp)
+  int since_reset_ = 0;  // accepted steps since the last reset
 };
 
 }  // namespace abuopt::detail

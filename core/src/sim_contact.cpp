@@ -93,6 +93,16 @@ void roots_contact(double tbar, const double* y, double* g, void* user) {
     g[2 * rs.n + k] = cs.closed[k] ? 1.0 : cs.geo.gap(y + lay.beta(0), k) + cs.off_gap[k];
 }
 
+void root_rates_contact(double, const double* y, double* gd, void* user) {
+  const auto& rs = *static_cast<const RunState*>(user);
+  const StateLayout& lay = rs.lay();
+  const ContactState& cs = rs.cs;
+  std::fill(gd, gd + 2 * rs.n, 0.0);
+  for (std::size_t k = 0; k < cs.geo.pairs(); ++k)
+    gd[2 * rs.n + k] = cs.closed[k] ? 0.0
+                                    : y[lay.beta_dot(cs.geo.order[(k + 1) % rs.n])] - y[lay.beta_dot(cs.geo.order[k])];
+}
+
 // Functions that start at or below zero by rounding are shifted so their later crossing is seen.
 void set_contact_root_offsets(RunState& rs, double tbar, const double* y) {
   const StateLayout& lay = rs.lay();
@@ -270,6 +280,21 @@ void choose_contact_modes(RunState& rs, double W, double Wp, std::vector<double>
   for (const Touch& tc : touch)
     for (std::size_t i : tc.balls) y[lay.beta_dot(i)] = tc.v;
 
+  // Options per touch cluster in the enumeration. Too many joint options (many balls: a chain
+  // of six touching balls has 3 * 4^5 of its own): touching balls move together (no cuts: the
+  // first 3, or 1 when moving, options of each), still every stick / slip choice per chain, so a
+  // chain whose margin has crossed zero (forced) is not left stuck. (Before, this case kept
+  // every ball stuck: a forced chain stayed stuck, its margin crossed zero again at once, and
+  // 9-ball runs ended at the chatter limit; docs/performance.md.)
+  std::vector<std::size_t> radix(touch.size());
+  for (std::size_t t = 0; t < touch.size(); ++t) radix[t] = touch[t].options;
+  if (total > 20000) {
+    total = 1;
+    for (std::size_t t = 0; t < touch.size(); ++t) {
+      radix[t] = touch[t].v == 0.0 ? 3 : 1;
+      total = total > 100000 ? total : total * radix[t];
+    }
+  }
   if (total <= 20000) {
     // Every joint option, the most stuck balls first, then the fewest cuts: the first
     // consistent one wins; if none is, the least violating one.
@@ -278,8 +303,8 @@ void choose_contact_modes(RunState& rs, double W, double Wp, std::vector<double>
     for (std::size_t code = 0; code < total; ++code) {
       std::size_t c = code;
       for (std::size_t t = 0; t < touch.size(); ++t) {
-        codes[t] = c % touch[t].options;
-        c /= touch[t].options;
+        codes[t] = c % radix[t];
+        c /= radix[t];
       }
       int sticks = 0, cuts = 0;
       for (std::size_t t = 0; t < touch.size(); ++t) {
@@ -301,8 +326,8 @@ void choose_contact_modes(RunState& rs, double W, double Wp, std::vector<double>
     for (const auto& o : order) {
       std::size_t c = o.second;
       for (std::size_t t = 0; t < touch.size(); ++t) {
-        codes[t] = c % touch[t].options;
-        c /= touch[t].options;
+        codes[t] = c % radix[t];
+        c /= radix[t];
       }
       int sticks = 0, cuts = 0;
       apply(sticks, cuts);
@@ -320,8 +345,8 @@ void choose_contact_modes(RunState& rs, double W, double Wp, std::vector<double>
     }
     std::size_t c = best_code;
     for (std::size_t t = 0; t < touch.size(); ++t) {
-      codes[t] = c % touch[t].options;
-      c /= touch[t].options;
+      codes[t] = c % radix[t];
+      c /= radix[t];
     }
   } else {
     std::fill(codes.begin(), codes.end(), 0);  // too many combinations: all clustered, all stuck or moving

@@ -118,6 +118,9 @@ bool all_stuck(const RunState& rs, const double* y);
 // the event step (impacts, then one consistent choice of clusters and modes).
 void contact_setup(RunState& rs, const double* y);
 void roots_contact(double tbar, const double* y, double* g, void* user);
+// The rates of the contact root functions where known: d gap_k / dtbar for open pairs, 0 for the
+// rest (the stepper's dip check, erk_stepper.hpp).
+void root_rates_contact(double tbar, const double* y, double* gd, void* user);
 void set_contact_root_offsets(RunState& rs, double tbar, const double* y);
 // Chooses clusters and modes at an instant: balls at zero relative speed and zero gap may form or
 // leave clusters, clusters at zero speed may stick or slip. forced[g] != 0: cluster g of the

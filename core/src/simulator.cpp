@@ -12,8 +12,8 @@
 // root the modes of all balls are chosen together (AbuModel::choose_modes) and the integrator is
 // reset. After the profile ends with every ball stuck (ideal motor), the table motion is linear
 // and time-invariant; if a bound on its transient proves that no stick margin can reach zero, the
-// run is finished in closed form (closed_form_tail). While every ball is stuck (ideal motor, no
-// contact), the default stuck integrator propagates the table exactly instead of stepping
+// run is finished in closed form (closed_form_tail). While every ball is stuck (ideal motor), the
+// default stuck integrator propagates the table exactly instead of stepping
 // (stuck_propagator.hpp, docs/stuck_propagator.md); the stepper restarts at the next event.
 //
 // The parts: sim_rhs.cpp (right-hand side and root functions), closed_form_tail.cpp,
@@ -32,6 +32,7 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/core/abu_model.hpp"
+#include "abuopt/core/sim_counters.hpp"
 #include "abuopt/core/simulation_config.hpp"
 #include "integrator.hpp"
 #include "sim_run_state.hpp"
@@ -70,11 +71,9 @@ Simulator::Simulator(SimulationSetup setup) : setup_(std::move(setup)) {
   // The exact stuck-phase propagator: its forcing integrals depend only on the profile and the
   // table, so they are computed once here and shared by every run.
   const NondimParameters nd = NondimParameters::from(setup_.abu);
-  // (Not with hard contact between two or more balls: such runs keep the Runge-Kutta path.)
-  const bool contact = setup_.abu.ball_contact == BallContact::Hard && setup_.abu.balls.size() >= 2;
   if (o.stuck_integrator == StuckIntegrator::Exact && o.method == FrictionMethod::EventDriven &&
-      setup_.motor.kind == MotorKind::Ideal && !contact && StuckForcingTable::supports(nd))
-    stuck_table_ = std::make_shared<const StuckForcingTable>(setup_.profile, nd, end_time_s() * nd.omega_n);
+      setup_.motor.kind == MotorKind::Ideal && StuckForcingTable::supports(nd))
+    stuck_table_ = StuckForcingTable::shared(setup_.profile, nd, end_time_s() * nd.omega_n);
 }
 
 Simulator::~Simulator() = default;
@@ -135,11 +134,9 @@ class Run {
     }
     choose_initial_modes();
     // The exact stuck-phase propagator needs the table of this run's omega_n and bbar (an
-    // imbalance-mass override changes both: such runs keep the Runge-Kutta path), no trajectory,
-    // and no ball contact (not validated with contact yet: docs/stuck_propagator.md section 5).
-    if (stuck_table && !rs_.pi_motor && event_driven_ && !(trajectory_ && traj_dt_ > 0) && !rs_.contact &&
-        stuck_table->matches(rs_.nd))
-      stuck_.emplace(*stuck_table, rs_, roots_plain);
+    // imbalance-mass override changes both: such runs keep the Runge-Kutta path) and no trajectory.
+    if (stuck_table && !rs_.pi_motor && event_driven_ && !(trajectory_ && traj_dt_ > 0) && stuck_table->matches(rs_.nd))
+      stuck_.emplace(*stuck_table, rs_, rs_.contact ? roots_contact : roots_plain);
   }
 
   RunOutcome execute();
@@ -152,6 +149,7 @@ class Run {
   }
   void choose_initial_modes();
   bool handle_event(double t);  // false: a guard ended the run (status set)
+  void count_event_kinds() const;  // into sim_counters(), from rinfo_ and the modes before the event
   bool count_event(double t);
   void track_all_stuck(double t) {
     if (all_stuck(rs_, y_.data())) {
@@ -255,7 +253,23 @@ void Run::record(double tt, const std::vector<double>& yy) {
 }
 
 // A root of the stick/slip functions at t: re-choose the modes, count the event, apply the guards.
+void Run::count_event_kinds() const {
+  SimCounters& c = sim_counters();
+  for (std::size_t i = 0; i < rs_.n; ++i) {
+    const bool stuck = rs_.modes[i] == BallMode::Stick;
+    if (stuck) {
+      c.stick_to_slip += (rinfo_[2 * i] != 0) + (rinfo_[2 * i + 1] != 0);
+    } else if (rinfo_[2 * i] != 0) {
+      // with contact, the first function of a slipping cluster's inner ball is its contact force
+      const bool inner = rs_.contact && rs_.cs.clusters.groups[static_cast<std::size_t>(rs_.cs.group_of[i])].back() != i;
+      ++(inner ? c.contact_open : c.slip_stop);
+    }
+  }
+  for (std::size_t k = 2 * rs_.n; k < rinfo_.size(); ++k) c.gap_closed += rinfo_[k] != 0;
+}
+
 bool Run::handle_event(double t) {
+  count_event_kinds();
   // A slipping ball whose speed reached zero may stick or reverse: a candidate. A stuck ball
   // whose friction margin reached zero leaves stick in the direction of the force needed to
   // hold it (the net force); the others are re-chosen consistently with that.

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
+#include <mutex>
 #include <stdexcept>
 
 namespace abuopt::detail {
@@ -52,7 +54,7 @@ bool StuckForcingTable::supports(const NondimParameters& nd) {
 }
 
 StuckForcingTable::StuckForcingTable(const StartupProfile& profile, const NondimParameters& nd, double t_end_bar)
-    : profile_(profile), omega_n_(nd.omega_n), bbar_(nd.bbar) {
+    : profile_(profile), t_end_bar_(t_end_bar), omega_n_(nd.omega_n), bbar_(nd.bbar) {
   if (!supports(nd)) throw std::invalid_argument("StuckForcingTable: needs 0 < bbar != 1");
   const cplx root = std::sqrt(cplx(bbar_ * bbar_ - 1.0, 0.0));
   lam_[0] = -bbar_ + root;
@@ -162,6 +164,44 @@ StuckForcingTable::StuckForcingTable(const StartupProfile& profile, const Nondim
     }
   }
   if (t_.size() < 2) throw std::invalid_argument("StuckForcingTable: empty time span");
+}
+
+bool StuckForcingTable::same(const StartupProfile& profile, const NondimParameters& nd, double t_end_bar) const {
+  if (!(t_end_bar == t_end_bar_ && nd.omega_n == omega_n_ && nd.bbar == bbar_ &&
+        profile.start_frequency_hz() == profile_.start_frequency_hz() &&
+        profile.segments().size() == profile_.segments().size()))
+    return false;
+  for (std::size_t k = 0; k < profile.segments().size(); ++k)
+    if (profile.segments()[k].end_frequency_hz != profile_.segments()[k].end_frequency_hz ||
+        profile.segments()[k].duration_s != profile_.segments()[k].duration_s)
+      return false;
+  return true;
+}
+
+std::shared_ptr<const StuckForcingTable> StuckForcingTable::shared(const StartupProfile& profile,
+                                                                   const NondimParameters& nd, double t_end_bar) {
+  static std::mutex mutex;
+  static std::deque<std::shared_ptr<const StuckForcingTable>> cache;  // most recently used first
+  auto lookup = [&]() -> std::shared_ptr<const StuckForcingTable> {
+    for (auto it = cache.begin(); it != cache.end(); ++it)
+      if ((*it)->same(profile, nd, t_end_bar)) {
+        auto hit = *it;
+        cache.erase(it);
+        cache.push_front(hit);
+        return hit;
+      }
+    return nullptr;
+  };
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (auto hit = lookup()) return hit;
+  }
+  auto table = std::make_shared<const StuckForcingTable>(profile, nd, t_end_bar);
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (auto hit = lookup()) return hit;  // another thread built it meanwhile
+  cache.push_front(table);
+  if (cache.size() > kSharedTables) cache.pop_back();
+  return table;
 }
 
 std::size_t StuckForcingTable::interval(double tbar) const {

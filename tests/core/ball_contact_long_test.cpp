@@ -1,6 +1,7 @@
-// The acceptance measurement of hard ball contact (label long, ~30 s): 1024 random starts of the
-// report's final profile for each of three seeds, two balls: every run ends ok and no final state
-// overlaps (clearance >= -1e-12 rad, rounding). docs/validation.md has the statistics.
+// The acceptance measurements of hard ball contact (label long, ~45 s): 1024 random starts of the
+// report's final profile for each of three seeds, two balls (every run ends ok), and for four balls
+// on both stuck integrators: no final state overlaps (clearance >= -1e-12 rad, rounding).
+// docs/validation.md has the statistics.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -26,5 +27,34 @@ TEST(BallContactLong, NoFinalStateOverlapsIn1024RandomStartsThreeSeeds) {
     }
     EXPECT_EQ(failed, 0) << "seed " << seed;
     EXPECT_EQ(overlaps, 0) << "seed " << seed;
+  }
+}
+
+// Issue 14: four balls, the exact all-stuck propagator (the default) against the Runge-Kutta
+// path, 1024 random starts (seed 202, the start that once ended with a 3.6e-7 rad overlap:
+// a gap that closed and opened again inside one Runge-Kutta step, docs/stuck_propagator.md 5).
+// No final state overlaps on either path. Runs that end at the chatter limit are counted
+// outcomes (10 of 1024 on both paths when measured: a chatter of the contact event handling, the
+// same with either stuck integrator; docs/performance.md): at most 2 %.
+TEST(BallContactLong, NoFinalStateOverlapsIn1024RandomStartsFourBallsBothStuckIntegrators) {
+  for (StuckIntegrator stuck : {StuckIntegrator::Exact, StuckIntegrator::RungeKutta}) {
+    SimulationSetup s;
+    s.abu.ball_contact = BallContact::Hard;
+    s.abu.balls.assign(4, Ball{});
+    s.options.stuck_integrator = stuck;
+    Simulator sim(s);
+    std::mt19937_64 rng(202);
+    std::uniform_real_distribution<double> u(0, 2 * M_PI);
+    int failed = 0, overlaps = 0;
+    for (int k = 0; k < 1024; ++k) {
+      const RunOutcome o = sim.run({u(rng), u(rng), u(rng), u(rng)});
+      failed += !o.ok();
+      if (!o.ok()) {
+        EXPECT_EQ(o.status, RunStatus::ChatterLimit) << o.message;
+      }
+      overlaps += min_contact_clearance(s.abu, o.beta_final) < -1e-12;
+    }
+    EXPECT_EQ(overlaps, 0) << to_string(stuck);
+    EXPECT_LE(failed, 20) << to_string(stuck);
   }
 }

@@ -229,3 +229,48 @@ TEST(ErkStepper, ARootAtTheStartOfAStepIsIgnored) {
   ASSERT_EQ(s, ErkStepper::Root);
   EXPECT_NEAR(st.t(), M_PI, 2e-5);
 }
+
+namespace {
+// y'' = 1 from y = 1e-3, y' = -0.1: y(t) = 1e-3 - 0.1 t + t^2 / 2 dips to -4e-3 at t = 0.1 and is
+// positive again from t = 0.1 + sqrt(0.008) = 0.1894 on; the first zero is 0.1 - sqrt(0.008).
+void parabola(double, const double* y, double* yd, void*) {
+  yd[0] = y[1];
+  yd[1] = 1.0;
+}
+void parabola_root(double, const double* y, double* g, void*) { g[0] = y[0]; }
+void parabola_rate(double, const double* y, double* gd, void*) { gd[0] = y[1]; }
+}  // namespace
+
+TEST(ErkStepper, ARootFunctionThatDipsThroughZeroInsideAStepIsFoundWithItsRate) {
+  // The solution is a polynomial of degree 2, which the 7(8) table integrates exactly, so the
+  // step size grows fast: from t = -20 to a stop time at -0.2, then one step to the stop time 1,
+  // which holds both crossings (g = y has the same sign at its ends). Without rates that step sees
+  // no root; with the rate dg/dt = y' the stepper finds the minimum on the interpolant and the
+  // crossing before it, polished on the Runge-Kutta solution to rounding.
+  auto y_at = [](double t) { return 1e-3 - 0.1 * t + 0.5 * t * t; };
+  const double y0[2] = {y_at(-20.0), -0.1 - 20.0};
+  const double first = 0.1 - std::sqrt(0.008);
+  for (bool rates : {false, true}) {
+    ErkStepper st(ButcherTable::from_arkode("ARKODE_FEHLBERG_13_7_8"), 2, parabola, parabola_root, 1, nullptr, 1e-6,
+                  1e-9, 1000);
+    st.set_polish_roots(true);
+    if (rates) st.set_root_rates(parabola_rate);
+    st.reset(-20.0, y0);
+    st.set_stop_time(-0.2);
+    ErkStepper::Status s = ErkStepper::Ok;
+    while (s == ErkStepper::Ok) s = st.step();
+    ASSERT_EQ(s, ErkStepper::StopReached);
+    st.set_stop_time(1.0);
+    s = st.step();
+    if (!rates) {
+      EXPECT_EQ(s, ErkStepper::StopReached);  // one step over both crossings: nothing seen
+      EXPECT_EQ(st.t(), 1.0);
+      continue;
+    }
+    // (the state carries the rounding of y(-20) = 202, ~3e-14, through the steps; divided by the
+    // slope 0.089 at the root that is ~1e-12 in time)
+    ASSERT_EQ(s, ErkStepper::Root);
+    EXPECT_NEAR(st.t(), first, 1e-11);
+    EXPECT_NEAR(st.y()[0], 0.0, 1e-12);
+  }
+}

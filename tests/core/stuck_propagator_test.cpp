@@ -203,3 +203,31 @@ TEST(StuckPropagator, WholeRunsAgreeWithTheRungeKuttaPathAtTightTolerance) {
 }
 
 }  // namespace
+
+// The process-wide cache of forcing tables: the same (profile, omega_n, bbar, end time) gives the
+// same table, any difference a new one; the least recently used of more than kSharedTables is
+// dropped; a cached table equals a freshly built one.
+TEST(StuckForcingTable, SharedTablesAreReusedForTheSameProfileAndTableOnly) {
+  const auto nd = abuopt::NondimParameters::from(AbuParameters{});
+  const StartupProfile p({{25.0, 0.5}, {40.0, 0.5}});
+  const double tend = 2.0 * nd.omega_n;
+  const auto a = StuckForcingTable::shared(p, nd, tend);
+  EXPECT_EQ(StuckForcingTable::shared(p, nd, tend), a);
+  EXPECT_NE(StuckForcingTable::shared(p, nd, 1.5 * nd.omega_n), a);                             // end time
+  EXPECT_NE(StuckForcingTable::shared(StartupProfile({{25.0, 0.5}, {40.0, 0.6}}), nd, tend), a);  // a duration
+  EXPECT_NE(StuckForcingTable::shared(StartupProfile({{25.0, 0.5}, {41.0, 0.5}}), nd, tend), a);  // a frequency
+  auto nd2 = nd;
+  nd2.bbar *= 1.01;
+  EXPECT_NE(StuckForcingTable::shared(p, nd2, tend), a);
+  // a is the least recently used of the five now: dropped, built again
+  const auto b = StuckForcingTable::shared(p, nd, tend);
+  EXPECT_NE(b, a);
+  const StuckForcingTable fresh(p, nd, tend);
+  ASSERT_EQ(b->intervals(), fresh.intervals());
+  for (std::size_t j = 0; j < fresh.intervals(); ++j) {
+    EXPECT_EQ(b->t(j), fresh.t(j));
+    EXPECT_EQ(b->forcing(0, j), fresh.forcing(0, j));
+    EXPECT_EQ(b->forcing(1, j), fresh.forcing(1, j));
+  }
+  EXPECT_EQ(StuckForcingTable::kSharedTables, 4u);
+}
