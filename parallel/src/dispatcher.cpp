@@ -99,7 +99,7 @@ void Dispatcher::worker() {
     } else {
       job->done += count;
     }
-    progress_.notify_all();
+    if (job->finished()) changed_.notify_all();
   }
 }
 
@@ -200,7 +200,14 @@ bool Dispatcher::pump() {
     send(w.bytes(), r, kTagAssign);
     busy = true;
   }
-  progress_.notify_all();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& j : jobs_)
+      if (j->finished()) {
+        changed_.notify_all();
+        break;
+      }
+  }
   return busy;
 }
 
@@ -227,36 +234,46 @@ void Dispatcher::run_study(const MonteCarloStudy& s, PreparedStudy& p, const Pro
   }
   work_.notify_all();
 
-  // Until the study is done: pump when no other thread does, else wait for a change. Naps of 20 us
-  // after traffic, doubling to 1 ms while none comes (few wake-ups while the ranks compute).
+  // Until the study is done: one waiting thread at a time is the pumper (the MPI calls for every
+  // study in flight, naps of 20 us after traffic doubling to 1 ms while none comes); the others
+  // sleep until their study is done or the pumper leaves (then one of them takes over).
   std::chrono::microseconds nap(20);
   std::size_t reported = static_cast<std::size_t>(-1);
+  bool pumper = false;
   while (true) {
     std::size_t done = 0;
     {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (job->finished() || !broken_.empty()) break;
+      std::unique_lock<std::mutex> lock(mutex_);
+      auto over = [&] { return job->finished() || !broken_.empty(); };
+      if (pumper)
+        changed_.wait_for(lock, nap, over);
+      else
+        changed_.wait(lock, [&] { return over() || !pumping_; });
+      if (over()) break;
+      if (!pumper) pumping_ = pumper = true;
       done = job->done;
     }
     if (progress && done != reported) progress(reported = done, job->total, elapsed());
     bool busy = false;
-    if (pump_.try_lock()) {
-      std::string pump_error;
-      try {
-        busy = pump();
-      } catch (const std::exception& e) {
-        pump_error = std::string("rank 0: ") + e.what();
-      }
-      pump_.unlock();
-      if (!pump_error.empty()) {  // a broken exchange: every study fails with the reason
-        std::lock_guard<std::mutex> lock(mutex_);
-        if (broken_.empty()) broken_ = pump_error;
-      }
+    std::string pump_error;
+    try {
+      std::lock_guard<std::mutex> mpi(pump_);
+      busy = pump();
+    } catch (const std::exception& e) {
+      pump_error = std::string("rank 0: ") + e.what();
+    }
+    if (!pump_error.empty()) {  // a broken exchange: every study fails with the reason
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (broken_.empty()) broken_ = pump_error;
+      changed_.notify_all();
     }
     nap = busy ? std::chrono::microseconds(20) : std::min(2 * nap, std::chrono::microseconds(1000));
-    std::unique_lock<std::mutex> lock(mutex_);
-    progress_.wait_for(lock, nap, [&] { return job->finished() || !broken_.empty(); });
   }
+  if (pumper) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pumping_ = false;
+  }
+  changed_.notify_all();
   {
     std::lock_guard<std::mutex> lock(mutex_);
     jobs_.remove(job);

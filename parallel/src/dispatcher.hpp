@@ -4,9 +4,9 @@
 // evaluates a batch of independent designs: docs/cluster.md, "Batches of evaluations") to rank 0's
 // own worker threads and, in chunks on request, to the serving ranks (the messages: wire.hpp).
 //
-// Threads: any thread may call run_study, several at once. Exactly one of them at a time (the one
-// holding the "pump") makes MPI calls (MPI_THREAD_SERIALIZED); the others wait for their study on
-// a condition variable and take the pump in turn. The worker threads make no MPI call.
+// Threads: any thread may call run_study, several at once. Exactly one of them at a time (the
+// "pumper") makes MPI calls (MPI_THREAD_SERIALIZED); the others sleep until their study is done or
+// the pumper's study is, and then one of them takes over. The worker threads make no MPI call.
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
@@ -81,13 +81,14 @@ class Dispatcher {
   const std::thread::id owner_;
 
   std::mutex mutex_;  // guards everything below but the threads vector
-  std::condition_variable work_;      // workers: a job opened, or stop
-  std::condition_variable progress_;  // study owners: a job changed
+  std::condition_variable work_;     // workers: a job opened, or stop
+  std::condition_variable changed_;  // study owners: a job finished, or the pumper left
   std::list<std::shared_ptr<Job>> jobs_;
   std::uint64_t last_id_ = 0;
   std::vector<RankState> rank_state_;
   std::size_t ranks_threads_ = 1;  // threads per rank of the latest study (chunk sizing)
   std::string broken_;  // the exchange failed (a defect): every study fails with this
+  bool pumping_ = false;  // a study owner is the pumper
   bool interrupt_seen_ = false;
   bool stop_ = false;
   bool finished_ = false;
