@@ -97,7 +97,7 @@ nlohmann::json read_json(const fs::path& p) {
   return nlohmann::json::parse(f);
 }
 
-// history.csv without its timing columns
+// A CSV (history.csv, tables.csv, ...) without its timing columns
 std::string history_without_timing(const fs::path& p) {
   std::ifstream f(p);
   std::string line, out;
@@ -105,8 +105,10 @@ std::string history_without_timing(const fs::path& p) {
   while (std::getline(f, line)) {
     std::vector<std::string> cells;
     std::string cell;
+    bool quoted = false;  // a comma inside "..." is text ("final profile, 19 s")
     for (char c : line) {
-      if (c == ',') {
+      if (c == '"') quoted = !quoted;
+      if (c == ',' && !quoted) {
         cells.push_back(cell);
         cell.clear();
       } else {
@@ -172,6 +174,11 @@ TEST(MpiCli, ReproduceOverTwoRanksIsIdenticalToOneProcess) {
   // the per-run CSV without its wall-time column
   EXPECT_EQ(history_without_timing(d1 / "runs" / "final" / "final.csv"),
             history_without_timing(d2 / "runs" / "final" / "final.csv"));
+  // the table's contact variant (a second study, run at the same time as the case over ranks)
+  EXPECT_EQ(history_without_timing(d1 / "tables_contact.csv"), history_without_timing(d2 / "tables_contact.csv"));
+  EXPECT_GT(text(d2 / "tables_contact.csv").size(), 100u);
+  EXPECT_EQ(history_without_timing(d1 / "runs" / "final" / "final_contact_hard.csv"),
+            history_without_timing(d2 / "runs" / "final" / "final_contact_hard.csv"));
 }
 
 TEST(MpiCli, CompareOverTwoRanksIsIdenticalToOneProcess) {
