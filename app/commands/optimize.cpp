@@ -171,6 +171,11 @@ PlotStatus write_convergence(const fs::path& dir, const opt::OptimizationResult&
     }
     f.commit();
   }
+  if (parallel::interrupted()) {  // mpirun kills the job a second after the Ctrl-C: the results first
+    PlotStatus skipped;
+    skipped.message = "skipped: interrupted under mpirun (a rerun with the same --out plots it)";
+    return skipped;
+  }
   XYLinesPlot p;
   p.csv_path = csv.string();
   p.png_path = png.string();
