@@ -86,6 +86,9 @@ int run_cli(int argc, char** argv) {
     app.exit(e);
     if (const std::string hint = abuopt::app::hint_for(app, argc, argv); !hint.empty()) std::cerr << hint << "\n";
     return 2;
+  } catch (const abuopt::parallel::Interrupted& e) {  // SIGTERM under mpirun (Ctrl-C), docs/cluster.md
+    std::cerr << "abuopt: " << e.what() << "\n";
+    return 130;
   } catch (const abuopt::ConfigError& e) {
     std::cerr << "abuopt: error: " << e.what() << "\n";
     return 2;

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Cost model of the Monte Carlo over MPI ranks (docs/performance.md, "MPI: cost model").
 
-Simulates the protocol of parallel/src/session.cpp event by event: rank 0's threads take guided
+Simulates the protocol of parallel/src/dispatcher.cpp (one study) event by event: rank 0's threads take guided
 chunks (a quarter of the remaining runs per thread, 1..64 runs) from a shared counter; every
 other rank asks rank 0 for a chunk for all its threads, runs it on its threads (the rank is free
 again when the slowest run of the chunk is done), and asks again with the outcomes. Rank 0's one

@@ -68,11 +68,14 @@ opt::ProblemSpec read_startup_profile_problem(YamlReader& r) {
   section.finish();
   problems::StartupProfileProblem check(settings);  // a bad design is a ConfigError now, before any run
   spec.label = r.get_string_or("label", "startup_profile");
-  // under mpirun every evaluation's Monte Carlo is spread over the ranks (the runs then go one at a
-  // time: run_compare sets threads 1)
+  // under mpirun every evaluation's Monte Carlo is spread over the ranks; the comparison's runs
+  // (starts x solvers, `threads` at once) share them: their studies go into one pool of runs
   std::shared_ptr<BatchRunner> runner;
+  const bool concurrent = parallel::session() && parallel::session()->concurrent_studies();
   if (parallel::session() && parallel::session()->size() > 1) runner = parallel::make_runner(settings.threads);
-  spec.make = [settings, runner] { return problems::make_startup_profile_problem(settings, runner); };
+  spec.make = [settings, runner, concurrent] {
+    return problems::make_startup_profile_problem(settings, runner, concurrent);
+  };
   read_run_settings(r, spec);
   r.finish();
   return spec;
@@ -120,8 +123,12 @@ int run_compare(const CompareArgs& a) {
   for (YamlReader& p : root.children("problems")) setup.problems.push_back(read_problem(p));
   for (YamlReader& s : root.children("solvers")) setup.solvers.push_back(opt::read_solver_spec(s));
   root.finish();
-  // under mpirun the ranks serve one Monte Carlo at a time: the runs go one after another
-  if (parallel::session() && parallel::session()->size() > 1) setup.threads = 1;
+  // under mpirun the runs go `threads` at once only if the ranks take studies from several threads;
+  // then each run's batches of evaluations are spread too (as in `optimize`)
+  if (parallel::session() && parallel::session()->size() > 1) {
+    if (!parallel::session()->concurrent_studies()) setup.threads = 1;
+    for (opt::SolverSpec& s : setup.solvers) s.options.scheduler = parallel::make_evaluation_scheduler();
+  }
   if (setup.problems.empty()) throw ConfigError("problems", "<missing>", "must list at least one problem");
   if (setup.solvers.empty()) throw ConfigError("solvers", "<missing>", "must list at least one solver");
 

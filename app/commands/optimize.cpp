@@ -171,6 +171,11 @@ PlotStatus write_convergence(const fs::path& dir, const opt::OptimizationResult&
     }
     f.commit();
   }
+  if (parallel::interrupted()) {  // mpirun kills the job a second after the Ctrl-C: the results first
+    PlotStatus skipped;
+    skipped.message = "skipped: interrupted under mpirun (a rerun with the same --out plots it)";
+    return skipped;
+  }
   XYLinesPlot p;
   p.csv_path = csv.string();
   p.png_path = png.string();
@@ -206,9 +211,13 @@ int run_optimize(const OptimizeArgs& a) {
   LoadedConfig cfg = load_config(a);
   StartupProfileProblem problem(cfg.settings);
   const auto& st = problem.settings();
-  // under mpirun every Monte Carlo (the evaluations and the validation) is spread over the ranks
-  if (parallel::session() && parallel::session()->size() > 1)
-    problem.set_monte_carlo_runner(parallel::make_runner(st.threads));
+  // under mpirun every Monte Carlo (the evaluations and the validation) is spread over the ranks,
+  // and a batch of independent evaluations (SAO's design, finite-difference neighbours) runs as
+  // concurrent studies whose runs share the ranks (docs/cluster.md, "Batches of evaluations")
+  if (parallel::session() && parallel::session()->size() > 1) {
+    problem.set_monte_carlo_runner(parallel::make_runner(st.threads), parallel::session()->concurrent_studies());
+    cfg.options.scheduler = parallel::make_evaluation_scheduler();
+  }
   // What the optimiser sees: the problem, or its penalty form (constraints.penalty_weight > 0).
   std::optional<opt::PenaltyProblem> penalised;
   if (st.constraints.penalty_weight > 0) penalised.emplace(problem, st.constraints.penalty_weight);

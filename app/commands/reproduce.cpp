@@ -85,8 +85,12 @@ int run_reproduce(const ReproduceArgs& a) {
   ReproductionOptions opt;
   opt.out_dir = a.out.empty() ? default_out_dir() : a.out;
   opt.threads = a.threads ? static_cast<std::size_t>(*a.threads) : 0;
-  // under mpirun every case's Monte Carlo is spread over the ranks
-  if (parallel::session() && parallel::session()->size() > 1) opt.runner = parallel::make_runner(opt.threads);
+  // under mpirun every case's Monte Carlo is spread over the ranks, a table's cases at once when the
+  // ranks take concurrent studies (their runs share one pool)
+  if (parallel::session() && parallel::session()->size() > 1) {
+    opt.runner = parallel::make_runner(opt.threads);
+    if (parallel::session()->concurrent_studies()) opt.cases_at_once = parallel::kEvaluationsAtOnce;
+  }
   opt.plots = !a.no_plots;
   opt.command_line = command_line(a, opt.out_dir);
   if (a.runs) opt.runs_note = override_runs(tables, static_cast<std::size_t>(*a.runs), "--runs");

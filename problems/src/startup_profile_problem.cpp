@@ -320,9 +320,10 @@ StartupProfileProblem::StartupProfileProblem(StartupProfileSettings settings) : 
 std::vector<std::string> StartupProfileProblem::inequality_names() const { return constraint_names_; }
 
 std::unique_ptr<opt::Problem> make_startup_profile_problem(const StartupProfileSettings& settings,
-                                                           std::shared_ptr<BatchRunner> runner) {
+                                                           std::shared_ptr<BatchRunner> runner,
+                                                           bool concurrent_studies) {
   auto problem = std::make_unique<StartupProfileProblem>(settings);
-  if (runner) problem->set_monte_carlo_runner(std::move(runner));
+  if (runner) problem->set_monte_carlo_runner(std::move(runner), concurrent_studies);
   const double w = settings.constraints.penalty_weight;
   if (w > 0) return std::make_unique<opt::PenaltyProblem>(std::move(problem), w);
   return problem;

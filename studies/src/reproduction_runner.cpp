@@ -1,7 +1,9 @@
 #include "abuopt/studies/reproduction_runner.hpp"
 
 #include <chrono>
+#include <deque>
 #include <filesystem>
+#include <future>
 #include <sstream>
 #include <stdexcept>
 
@@ -56,6 +58,31 @@ ReproductionReport run_reproduction(const std::vector<ReproductionTable>& tables
     runs_before += study.runs;
     return r;
   };
+  // With cases_at_once > 1 a table's studies (each case, then its contact variant) start ahead, up
+  // to cases_at_once running, and are taken in order: files and tables as one after another.
+  // (declared before `ahead`: a future of std::async waits for its study when destroyed, e.g.
+  // after an exception, and the study must still be there)
+  std::deque<MonteCarloStudy> contact_studies;  // a deque: push_back keeps the pointers valid
+  std::deque<const MonteCarloStudy*> to_start;
+  std::deque<std::future<MonteCarloResult>> ahead;
+  auto start_ahead = [&] {
+    while (!to_start.empty() && ahead.size() < opt.cases_at_once) {
+      const MonteCarloStudy* st = to_start.front();
+      to_start.pop_front();
+      ahead.push_back(std::async(std::launch::async, [&runner, st] { return run_monte_carlo(*st, runner); }));
+    }
+  };
+  auto next_result = [&](const MonteCarloStudy& study) {
+    if (opt.cases_at_once <= 1) return run_case(study);
+    start_ahead();
+    std::future<MonteCarloResult> f = std::move(ahead.front());
+    ahead.pop_front();
+    MonteCarloResult r = f.get();
+    runs_before += study.runs;
+    if (opt.progress) opt.progress(runs_before, total_runs);
+    start_ahead();
+    return r;
+  };
   const auto t_start = clock::now();
 
   for (const ReproductionTable& table : tables) {
@@ -65,9 +92,20 @@ ReproductionReport run_reproduction(const std::vector<ReproductionTable>& tables
     const fs::path run_dir = out / "runs" / table_dir_name(table.id);
     fs::create_directories(run_dir, ec);
     if (ec) throw OutputError("cannot create " + run_dir.string() + " (" + ec.message() + ")");
+    if (opt.cases_at_once > 1) {
+      contact_studies.clear();  // the previous table's studies are all taken
+      for (const ReproductionCase& c : table.cases) {
+        to_start.push_back(&c.study);
+        if (!table.contact_variant) continue;
+        MonteCarloStudy cs = c.study;
+        cs.setup.abu.ball_contact = *table.contact_variant;
+        contact_studies.push_back(std::move(cs));
+        to_start.push_back(&contact_studies.back());
+      }
+    }
     for (std::size_t k = 0; k < table.cases.size(); ++k) {
       const ReproductionCase& c = table.cases[k];
-      MonteCarloResult result = run_case(c.study);
+      MonteCarloResult result = next_result(c.study);
       const fs::path csv_path = run_dir / (c.id + ".csv");
       {
         std::ostringstream f;
@@ -90,7 +128,7 @@ ReproductionReport run_reproduction(const std::vector<ReproductionTable>& tables
       if (table.contact_variant) {
         MonteCarloStudy cs = c.study;
         cs.setup.abu.ball_contact = *table.contact_variant;
-        MonteCarloResult cr = run_case(cs);
+        MonteCarloResult cr = next_result(cs);
         {
           std::ostringstream f;
           write_runs_csv(f, cr.samples);

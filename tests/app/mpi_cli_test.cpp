@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstdio>
@@ -17,6 +18,8 @@
 #include <iterator>
 #include <iostream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -94,7 +97,7 @@ nlohmann::json read_json(const fs::path& p) {
   return nlohmann::json::parse(f);
 }
 
-// history.csv without its timing columns
+// A CSV (history.csv, tables.csv, ...) without its timing columns
 std::string history_without_timing(const fs::path& p) {
   std::ifstream f(p);
   std::string line, out;
@@ -102,8 +105,10 @@ std::string history_without_timing(const fs::path& p) {
   while (std::getline(f, line)) {
     std::vector<std::string> cells;
     std::string cell;
+    bool quoted = false;  // a comma inside "..." is text ("final profile, 19 s")
     for (char c : line) {
-      if (c == ',') {
+      if (c == '"') quoted = !quoted;
+      if (c == ',' && !quoted) {
         cells.push_back(cell);
         cell.clear();
       } else {
@@ -169,6 +174,11 @@ TEST(MpiCli, ReproduceOverTwoRanksIsIdenticalToOneProcess) {
   // the per-run CSV without its wall-time column
   EXPECT_EQ(history_without_timing(d1 / "runs" / "final" / "final.csv"),
             history_without_timing(d2 / "runs" / "final" / "final.csv"));
+  // the table's contact variant (a second study, run at the same time as the case over ranks)
+  EXPECT_EQ(history_without_timing(d1 / "tables_contact.csv"), history_without_timing(d2 / "tables_contact.csv"));
+  EXPECT_GT(text(d2 / "tables_contact.csv").size(), 100u);
+  EXPECT_EQ(history_without_timing(d1 / "runs" / "final" / "final_contact_hard.csv"),
+            history_without_timing(d2 / "runs" / "final" / "final_contact_hard.csv"));
 }
 
 TEST(MpiCli, CompareOverTwoRanksIsIdenticalToOneProcess) {
@@ -204,6 +214,121 @@ solvers:
   EXPECT_EQ(history_without_timing(d1 / "runs.csv"), history_without_timing(d2 / "runs.csv"));
   EXPECT_EQ(history_without_timing(d1 / "convergence.csv"), history_without_timing(d2 / "convergence.csv"));
   EXPECT_GT(history_without_timing(d2 / "runs.csv").size(), 100u);
+}
+
+// An `optimize` config: quick.yaml's problem (`runs` runs per evaluation) with another optimizer section.
+fs::path optimize_config(const std::string& name, const std::string& optimizer, int runs = 16) {
+  std::ifstream in(kQuick);
+  std::string text(std::istreambuf_iterator<char>(in), {});
+  text = text.substr(0, text.find("\noptimizer:") + 1) + optimizer;
+  const std::string quick_runs = "  runs: 16";
+  text.replace(text.find(quick_runs), quick_runs.size(), "  runs: " + std::to_string(runs));
+  const fs::path cfg = fs::path(ABUOPT_BINARY_DIR) / "mpi_cli_test" / (name + ".yaml");
+  fs::create_directories(cfg.parent_path());
+  std::ofstream(cfg) << text;
+  return cfg;
+}
+
+// Batches of independent evaluations (SAO's designs of 2x the terms per region, SLSQP's
+// finite-difference neighbours) run as concurrent studies whose runs share the ranks: the result
+// and the history are those of one process, for 1, 2 and 3 ranks.
+TEST(MpiCli, BatchesOfEvaluationsOverRanksAreIdenticalToOneProcess) {
+  REQUIRE_MPI();
+  const std::vector<std::pair<std::string, std::string>> runs = {
+      {"batch_sao", "optimizer:\n  algorithm: sao\n  max_evaluations: 16\nsao:\n  doe_points_factor: 2\n"},
+      {"batch_slsqp", "optimizer:\n  algorithm: slsqp\n  max_evaluations: 14\n"}};
+  for (const auto& [name, optimizer] : runs) {
+    const fs::path cfg = optimize_config(name, optimizer);
+    const fs::path d0 = fresh_dir(name + "_plain");
+    const Shell one = shell(plain("optimize " + cfg.string() + " --out " + d0.string()));
+    ASSERT_EQ(one.status, 0) << one.output;
+    const auto result = strip(read_json(d0 / "result.json"));
+    const std::string history = history_without_timing(d0 / "history.csv");
+    EXPECT_GE(std::count(history.begin(), history.end(), '\n'), 14) << name;  // header + the evaluations
+    for (int ranks : {1, 2, 3}) {
+      const fs::path d = fresh_dir(name + "_np" + std::to_string(ranks));
+      const Shell r = shell(mpirun(ranks, "optimize " + cfg.string() + " --out " + d.string()));
+      ASSERT_EQ(r.status, 0) << name << " on " << ranks << " ranks:\n" << r.output;
+      EXPECT_EQ(result, strip(read_json(d / "result.json"))) << name << " on " << ranks << " ranks";
+      EXPECT_EQ(history, history_without_timing(d / "history.csv")) << name << " on " << ranks << " ranks";
+    }
+  }
+}
+
+// Ctrl-C: SIGINT to mpirun, which sends SIGTERM to every rank (SIGKILL a second later). Each rank
+// runs under `sh` that records its exit status (the shell ignores SIGTERM; abuopt installs its own
+// handler). Open MPI's mpirun itself always ends with 1 once interrupted, whatever the ranks return.
+// `timeout --foreground`: the SIGINT reaches mpirun only (without it, timeout sends it to its whole
+// process group, the ranks' shells included, which is not what a Ctrl-C to mpirun does).
+struct Interrupted {
+  int mpirun_status;
+  std::string output;
+  double seconds_after_sigint;
+  int rank_status[2];
+};
+
+Interrupted interrupt_two_ranks(const fs::path& dir, const std::string& args, const std::string& wait_for_text) {
+  fs::create_directories(dir);
+  const std::string log = (dir / "log.txt").string();
+  const std::string rank_cmd = "trap '' TERM; " + std::string(ABUOPT_EXE) + " " + args + "; echo \\$? > " +
+                               (dir / "status.").string() + "\\$OMPI_COMM_WORLD_RANK";
+  const std::string cmd =
+      "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 "
+      "timeout --foreground -k 5 120 " +
+      kMpirun + " --oversubscribe -n 2 sh -c \"" + rank_cmd + "\" > " + log + " 2>&1 & P=$!; " +
+      "for i in $(seq 600); do grep -q '" + wait_for_text + "' " + log + " && break; sleep 0.1; done; " +
+      "T0=$(date +%s%N); kill -INT $P; wait $P; S=$?; T1=$(date +%s%N); echo \"status $S ns $((T1 - T0))\"";
+  const Shell r = shell(cmd);
+  Interrupted out{-1, "", 0, {-1, -1}};
+  long long ns = 0;
+  std::sscanf(r.output.c_str(), "status %d ns %lld", &out.mpirun_status, &ns);
+  out.seconds_after_sigint = static_cast<double>(ns) * 1e-9;
+  std::ifstream f(log);
+  out.output = std::string(std::istreambuf_iterator<char>(f), {});
+  for (int k = 0; k < 2; ++k) {
+    std::ifstream st(dir / ("status." + std::to_string(k)));
+    st >> out.rank_status[k];
+  }
+  return out;
+}
+
+TEST(MpiCli, CtrlCStopsAnOptimisationOnEveryRankWritesAndResumes) {
+  REQUIRE_MPI();
+  // 64 runs per evaluation, a budget far beyond what runs before the Ctrl-C (SLSQP: batches)
+  const fs::path cfg = optimize_config("ctrl_c", "optimizer:\n  algorithm: slsqp\n  max_evaluations: 500\n", 64);
+  const fs::path d = fresh_dir("ctrl_c");
+  const Interrupted r = interrupt_two_ranks(d, "optimize " + cfg.string() + " --out " + d.string(), "eval    8");
+  EXPECT_NE(r.mpirun_status, 0) << r.output;
+  EXPECT_NE(r.mpirun_status, 124) << "timed out: " << r.output;
+  EXPECT_LT(r.seconds_after_sigint, 10) << r.output;
+  EXPECT_EQ(r.rank_status[0], 130) << r.output;  // rank 0: interrupted, as one process
+  // the serving rank leaves with 130 when rank 0 ends the command; mpirun, ending the job, may kill
+  // its shell before that shell has recorded it (-1)
+  EXPECT_TRUE(r.rank_status[1] == 130 || r.rank_status[1] == -1) << r.rank_status[1] << "\n" << r.output;
+  EXPECT_NE(r.output.find("interrupted: the best design so far is written"), std::string::npos) << r.output;
+  const nlohmann::json j = read_json(d / "result.json");
+  EXPECT_EQ(j["reason"], "interrupted") << j.dump(1);
+  const long done = j["evaluations"].get<long>();
+  EXPECT_GE(done, 8);
+  EXPECT_LT(done, 500);
+  // a rerun with the budget that was done answers everything from the archive
+  const Shell again = shell(mpirun(2, "optimize " + cfg.string() + " --max-evaluations " +
+                                          std::to_string(done) + " --out " + d.string()));
+  ASSERT_EQ(again.status, 0) << again.output;
+  EXPECT_NE(again.output.find("(resuming"), std::string::npos) << again.output;
+  EXPECT_EQ(read_json(d / "result.json")["archive_hits"].get<long>(), done) << again.output;
+}
+
+TEST(MpiCli, CtrlCStopsAMonteCarloOnEveryRank) {
+  REQUIRE_MPI();
+  const fs::path d = fresh_dir("ctrl_c_mc");
+  const Interrupted r = interrupt_two_ranks(
+      d, "montecarlo " + kFinal + " --design random --runs 200000 --threads 1 --progress", "runs (");
+  EXPECT_NE(r.mpirun_status, 124) << "timed out: " << r.output;
+  EXPECT_LT(r.seconds_after_sigint, 10) << r.output;
+  EXPECT_EQ(r.rank_status[0], 130) << r.output;
+  EXPECT_TRUE(r.rank_status[1] == 130 || r.rank_status[1] == -1) << r.rank_status[1] << "\n" << r.output;
+  EXPECT_NE(r.output.find("abuopt: interrupted"), std::string::npos) << r.output;
 }
 
 TEST(MpiCli, ABadConfigEndsEveryRankWithTheMessageOnce) {

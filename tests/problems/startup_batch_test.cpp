@@ -1,7 +1,7 @@
 // Evaluation concurrency on the startup problem (issue 9 item 4): SAO with a design in every
 // region, on a 4-run Monte Carlo, gives the same history, bit for bit, with 1, 2 and 4 evaluation
 // workers (the Monte Carlo threads shared among them), and the problem declares itself
-// thread-safe only while no Monte Carlo runner is set.
+// thread-safe only while no Monte Carlo runner is set, or one that takes concurrent studies.
 #include <gtest/gtest.h>
 
 #include <memory>
@@ -83,6 +83,12 @@ TEST(StartupBatch, ThreadSafeOnlyWithoutAMonteCarloRunner) {
   p.set_monte_carlo_runner(std::make_shared<ThreadPoolRunner>(1));
   EXPECT_FALSE(p.thread_safe());
   EXPECT_EQ(p.evaluate(x).objective, plain.objective);
+  // a runner that takes studies from several threads at once (MPI ranks) keeps it thread-safe
+  p.set_monte_carlo_runner(std::make_shared<ThreadPoolRunner>(1), true);
+  EXPECT_TRUE(p.thread_safe());
+  EXPECT_EQ(p.evaluate_shared(x, 2).objective, plain.objective);
+  p.set_monte_carlo_runner(nullptr, true);  // no runner: the flag means nothing
+  EXPECT_TRUE(p.thread_safe());
 }
 
 }  // namespace

@@ -188,13 +188,18 @@ class StartupProfileProblem : public opt::Problem {
   // Evaluation concurrency (optimizer/evaluation_scheduler.hpp): evaluations are independent and
   // may run at once, each with its share of the Monte Carlo threads: one of `concurrent` gets
   // max(1, T / concurrent) of montecarlo.threads = T (0: all cores). With a Monte Carlo runner set
-  // (set_monte_carlo_runner) evaluations go one at a time, each spread by that runner.
-  bool thread_safe() const override { return !runner_; }
+  // (set_monte_carlo_runner) evaluations go one at a time, each spread by that runner, unless the
+  // runner takes studies from several threads at once (MPI ranks: abuopt::parallel).
+  bool thread_safe() const override { return !runner_ || runner_concurrent_; }
   opt::Evaluation evaluate_shared(const std::vector<double>& x, std::size_t concurrent) override;
   // Every Monte Carlo of this problem then runs on `runner` (e.g. MPI ranks, abuopt::parallel),
   // which must outlive the evaluations; null: a ThreadPoolRunner of montecarlo.threads each time.
-  // Results do not depend on it.
-  void set_monte_carlo_runner(std::shared_ptr<BatchRunner> runner) { runner_ = std::move(runner); }
+  // Results do not depend on it. `concurrent_studies`: the runner's run_study may be called from
+  // several threads at once (then evaluations may run at once too: thread_safe()).
+  void set_monte_carlo_runner(std::shared_ptr<BatchRunner> runner, bool concurrent_studies = false) {
+    runner_ = std::move(runner);
+    runner_concurrent_ = runner_ && concurrent_studies;
+  }
 
   const StartupProfileSettings& settings() const { return settings_; }
 
@@ -233,6 +238,7 @@ class StartupProfileProblem : public opt::Problem {
   std::vector<Slot> slots_;
   std::vector<std::string> constraint_names_;
   std::shared_ptr<BatchRunner> runner_;
+  bool runner_concurrent_ = false;
 
   opt::Evaluation evaluate_with_threads(const StartupProfile& profile, const InitialConditionDesign& design,
                                         std::size_t runs, std::uint64_t seed, std::size_t threads) const;
@@ -245,8 +251,10 @@ namespace abuopt::problems {
 // The problem as the optimisers see it: a StartupProfileProblem, or with
 // constraints.penalty_weight > 0 its exact-L1-penalty form (opt::PenaltyProblem owning it). Throws
 // ConfigError for invalid settings.
-// `runner`: where its Monte Carlo studies run (StartupProfileProblem::set_monte_carlo_runner).
+// `runner`: where its Monte Carlo studies run (StartupProfileProblem::set_monte_carlo_runner, with
+// `concurrent_studies`).
 std::unique_ptr<opt::Problem> make_startup_profile_problem(const StartupProfileSettings& settings,
-                                                           std::shared_ptr<BatchRunner> runner = nullptr);
+                                                           std::shared_ptr<BatchRunner> runner = nullptr,
+                                                           bool concurrent_studies = false);
 
 }  // namespace abuopt::problems

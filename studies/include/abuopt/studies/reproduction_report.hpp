@@ -50,6 +50,11 @@ struct ReproductionOptions {
   // Where every case's Monte Carlo runs (e.g. MPI ranks: abuopt::parallel); null: a
   // ThreadPoolRunner of `threads`. Results do not depend on it.
   std::shared_ptr<BatchRunner> runner;
+  // How many of a table's Monte Carlo studies (cases, contact variants) run at once: > 1 only for
+  // a runner that takes studies from several threads (MPI ranks: their runs then share one pool,
+  // docs/cluster.md). Results, files and log lines are the same, in case order; progress is then
+  // reported per case.
+  std::size_t cases_at_once = 1;
   bool plots = true;
   std::string command_line;      // for the report's settings section
   std::string runs_note;         // from override_runs, for the report ("" = report's run counts)
