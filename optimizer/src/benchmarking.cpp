@@ -231,6 +231,14 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
         }
         rec.best_true_objective = best;
         rec.feasible = std::isfinite(best);
+        if (spec.validate && !rec.result.x.empty()) {
+          try {
+            rec.validation = spec.validate(rec.result.x);
+          } catch (const std::exception& e) {
+            rec.validation = Evaluation::failed(std::string("validation threw: ") + e.what());
+          }
+          rec.validation_feasible = is_feasible(*rec.validation, spec.constraint_tolerance);
+        }
         out.runs[first_run + t] = std::move(rec);
       }
     };
@@ -367,7 +375,8 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
   {
     OutFile f(dir / "runs.csv", written);
     f << "problem,start,solver,algorithm,dimension,x0,reason,best_true_objective,feasible,objective,max_violation,"
-         "evaluations,evaluations_to_tau,f_star,wall_time_s,message\n";
+         "evaluations,evaluations_to_tau,f_star,wall_time_s,samples,validated_objective,validated_max_violation,"
+         "validated_feasible,message\n";
     for (const RunRecord& run : r.runs) {
       std::string x0;
       for (double v : run.x0) x0 += (x0.empty() ? "" : " ") + format_number(v);
@@ -378,7 +387,13 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
         << "," << csv_number(run.best_true_objective) << "," << (run.feasible ? 1 : 0) << ","
         << csv_number(run.result.objective) << "," << csv_number(run.result.max_violation) << ","
         << run.result.evaluations << "," << run.evaluations_to_solve << "," << csv_number(r.f_star[p]) << ","
-        << csv_number(run.result.wall_time_s) << "," << csv_text(run.result.message) << "\n";
+        << csv_number(run.result.wall_time_s) << "," << run.result.samples << ",";
+      if (run.validation)
+        f << csv_number(run.validation->objective) << "," << csv_number(max_constraint_violation(*run.validation)) << ","
+          << (run.validation_feasible ? 1 : 0) << ",";
+      else
+        f << ",,,";
+      f << csv_text(run.result.message) << "\n";
     }
     f.commit();
   }

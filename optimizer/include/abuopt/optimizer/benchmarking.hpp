@@ -66,6 +66,10 @@ struct ProblemSpec {
   std::uint64_t seed = 1;              // of the random starts; run k of a solver gets seed + k
   double constraint_tolerance = 1e-6;  // feasibility tolerance of every run on it
   std::optional<double> f_star;        // reference value (else best_known(), else best found)
+  // Out-of-sample check of every run's result (e.g. the startup problem on its validation set:
+  // fresh runs of a seed no optimiser saw); empty: none. Called once per run on the result's x
+  // (thread-safe: runs may go at once), never for a run without a point.
+  std::function<Evaluation(const std::vector<double>& x)> validate;
 };
 
 struct RunRecord;
@@ -101,6 +105,9 @@ struct RunRecord {
   bool feasible = false;
   long evaluations_to_solve = -1;  // t_{p,s}; -1: not solved
   std::vector<ConvergencePoint> convergence;
+  // ProblemSpec::validate of result.x (unset without one); feasible within the run's tolerance
+  std::optional<Evaluation> validation;
+  bool validation_feasible = false;
 };
 
 struct ComparisonResult {
