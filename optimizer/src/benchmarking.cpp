@@ -21,6 +21,7 @@
 #include "abuopt/common/text.hpp"
 #include "abuopt/optimizer/algorithms.hpp"
 #include "abuopt/optimizer/minimize.hpp"
+#include "abuopt/optimizer/two_stage.hpp"
 
 namespace abuopt::opt {
 
@@ -77,6 +78,14 @@ SolverSpec read_solver_spec(YamlReader& r) {
     if (find_algorithm(algorithm, r.key_path("algorithm")).name != "SAO")
       throw ConfigError(r.key_path("sao"), "<section>", "only for algorithm sao (this solver is " + algorithm + ")");
     s.options.sao = read_sao_options(sao);
+  }
+  YamlReader then = r.child("then");
+  if (then.present()) {
+    if (then.has("then")) throw ConfigError(then.key_path("then"), "<section>", "two stages at most");
+    SolverSpec second = read_solver_spec(then);
+    s.then = second.options;
+    s.first_fraction = r.get_double_or("first_fraction", s.first_fraction, Rule::in_range(1e-6, 1 - 1e-6));
+    s.penalty_weight = r.get_double_or("penalty_weight", s.penalty_weight, Rule::positive());
   }
   r.finish();
   return s;
@@ -178,6 +187,7 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
     if (!labels.insert(s.label).second) throw ConfigError("compare.solvers", s.label, "duplicate solver label");
     if (find_algorithm(s.options.algorithm).name == "SAO") s.options.sao.validate("compare.solvers[" + s.label + "].sao");
     s.options.validate();
+    if (s.then) s.then->validate();
   }
 
   ComparisonResult out;
@@ -212,7 +222,20 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
         rec.dimension = problem->dimension();
         rec.x0 = starts[k];
         try {
-          rec.result = minimize(*problem, o, starts[k]);
+          if (solver.then) {
+            TwoStageOptions two;
+            two.first = o;
+            two.then = *solver.then;
+            two.then.constraint_tolerance = o.constraint_tolerance;
+            two.then.seed = o.seed;
+            two.then.handle_sigint = o.handle_sigint;
+            if (setup.threads > 1 && two.then.evaluation_threads == 0) two.then.evaluation_threads = 1;
+            two.first_fraction = solver.first_fraction;
+            two.penalty_weight = solver.penalty_weight;
+            rec.result = minimize_two_stage(*problem, two, spec.max_evaluations, starts[k]);
+          } else {
+            rec.result = minimize(*problem, o, starts[k]);
+          }
         } catch (const ConfigError& e) {
           // e.g. a bound-only global algorithm on a constrained problem: recorded as a failed run
           rec.result.problem_name = problem->name();

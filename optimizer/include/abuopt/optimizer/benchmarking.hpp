@@ -47,11 +47,18 @@ struct SolverSpec {
   std::string label;         // its name in tables and plots (unique)
   OptimizerOptions options;  // algorithm and settings (SAO's in options.sao); max_evaluations,
                              // constraint_tolerance and seed are set per run from the ProblemSpec
+  // A second stage (two_stage.hpp), e.g. DIRECT_L then COBYLA: `options` runs first with
+  // first_fraction of the budget (on the penalty form of weight penalty_weight when it handles
+  // bounds only and the problem has constraints), `then` from its best point with the rest.
+  std::optional<OptimizerOptions> then;
+  double first_fraction = 0.3;
+  double penalty_weight = 100.0;
 };
 // A solver with default settings; `algorithm` is checked (ConfigError listing the valid names).
 SolverSpec solver_spec(const std::string& label, const std::string& algorithm);
 // Reads one solver entry: label, algorithm (any minimize() name or sao), optional `options:`
-// (the keys of an optimizer: section except algorithm) and `sao:` sections.
+// (the keys of an optimizer: section except algorithm) and `sao:` sections, and optionally a second
+// stage: `then: {algorithm: cobyla, options: {...}}`, `first_fraction: 0.3`, `penalty_weight: 100`.
 SolverSpec read_solver_spec(YamlReader& entry);
 
 // Makes a fresh instance of a problem (called once per run).
