@@ -328,10 +328,10 @@ Tally run_starts(const std::string& name, double amplitude, std::size_t n_max, c
 }
 
 // Measured (docs/sao.md): the sampled noisy benchmarks (one run's noise 2 % relative, 256 runs at
-// most: sd 0.125 % at 256, 0.5 % at 16), 12 starts each (the shipped one and 11 random, seeds
-// 401 and 402: 72 runs per schedule), SAO's defaults at a fixed 256 runs against the schedule from
+// most: sd 0.125 % at 256, 0.5 % at 16), 12 starts each (the shipped one and 11 random, seed 401:
+// 36 runs per schedule; the docs' tables add seeds 402, 501, 502), SAO's defaults at a fixed 256 runs against the schedule from
 // 16 to 256. Solved: a point feasible within 1e-2 on the noise-free problem and within 1 % of f*
-// there. Counted: the simulations until then. The data profile over the 72 runs, solved within S
+// there. Counted: the simulations until then. The data profile over the runs, solved within S
 // simulations for S = 1k .. 32k and at all, must favour the schedule at small S and lose at most a
 // tenth of the solved runs at the end.
 TEST(SaoSampling, FewerSimulationsThanFixedSizeOnNoisyBenchmarks) {
@@ -340,8 +340,21 @@ TEST(SaoSampling, FewerSimulationsThanFixedSizeOnNoisyBenchmarks) {
   const int starts = 12;
   const long budget = 300;
   std::vector<double> fixed_all, adaptive_all;  // per run: simulations to solve, inf if never
+  // seed 401 in the default suite (36 runs per schedule; ~6 s, kept short for the sanitizer
+  // builds); ABUOPT_MEASURE_SEEDS="401 402" (and AMP=0.05, ...) reproduce the tables of docs/sao.md
+  std::vector<std::uint64_t> seeds{401};
+  if (const char* env = std::getenv("ABUOPT_MEASURE_SEEDS")) {
+    seeds.clear();
+    for (char* p = const_cast<char*>(env); *p;) {
+      char* end = nullptr;
+      const unsigned long long v = std::strtoull(p, &end, 10);
+      if (end == p) break;
+      seeds.push_back(v);
+      p = end;
+    }
+  }
   for (const std::string name : {"hs071", "cantilever", "two_bar_truss"}) {
-    for (const std::uint64_t seed : {401u, 402u}) {
+    for (const std::uint64_t seed : seeds) {
       opt::SaoOptions fixed;  // every evaluation at 256 runs
       opt::SaoOptions adaptive;
       adaptive.samples.initial = 16;
