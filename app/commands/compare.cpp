@@ -9,6 +9,7 @@
 //       dimension: 2                 # rosenbrock only
 //       noise_amplitude: 1e-3        # noisy_* only
 //       noise_seed: 1                # noisy_* only
+//       noise_samples: 0             # noisy_* only: N > 0, a mean of N runs (sample size for SAO's adaptive schedule)
 //       max_evaluations: 300         # budget of every run
 //       starts: 3                    # initial point + 2 seeded random points
 //       seed: 1
@@ -76,6 +77,14 @@ opt::ProblemSpec read_startup_profile_problem(YamlReader& r) {
   spec.make = [settings, runner, concurrent] {
     return problems::make_startup_profile_problem(settings, runner, concurrent);
   };
+  // every run's result checked out of sample, on the validation section's fresh runs (as optimize
+  // does; validation.enabled: false turns it off): the constrained problem, whatever the penalty
+  if (settings.validation.enabled) {
+    auto validator = std::make_shared<const problems::StartupProfileProblem>(settings);
+    spec.validate = [validator](const std::vector<double>& x) {
+      return validator->evaluate_out_of_sample(validator->profile_at(x));
+    };
+  }
   read_run_settings(r, spec);
   r.finish();
   return spec;
@@ -94,6 +103,8 @@ opt::ProblemSpec read_problem(YamlReader& r) {
   settings.noise_amplitude = r.get_double_or("noise_amplitude", settings.noise_amplitude, Rule::in_range(0, 0.999));
   settings.noise_seed =
       static_cast<std::uint64_t>(r.get_int_or("noise_seed", static_cast<long>(settings.noise_seed), Rule::non_negative()));
+  settings.noise_samples = static_cast<std::size_t>(
+      r.get_int_or("noise_samples", static_cast<long>(settings.noise_samples), Rule::in_range(0, 1 << 24)));
   opt::benchmarks::make_benchmark(name, settings);  // an unknown name is a ConfigError now, listing the valid ones
   spec.label = r.get_string_or("label", name == "rosenbrock" || name == "noisy_rosenbrock"
                                             ? name + std::to_string(settings.dimension)
@@ -141,6 +152,11 @@ int run_compare(const CompareArgs& a) {
     std::ostringstream line;
     line << "[" << done << "/" << total << "] " << r.problem << " start " << r.start << " " << r.solver << ": "
          << r.result.brief_report();
+    if (r.result.samples > 0) line << "; " << r.result.samples << " simulations";
+    if (r.validation)
+      line << "; out of sample f = " << opt::format_number(r.validation->objective)
+           << (r.validation_feasible ? " feasible" : " infeasible (violation " +
+                                                         opt::format_number(opt::max_constraint_violation(*r.validation)) + ")");
     bar.message(line.str());
     bar.update(done);
   };
@@ -173,6 +189,9 @@ int run_compare(const CompareArgs& a) {
                            {"feasible", r.feasible},
                            {"evaluations", r.result.evaluations},
                            {"evaluations_to_tau", r.evaluations_to_solve},
+                           {"samples", r.result.samples},
+                           {"validated_objective", r.validation ? number(r.validation->objective) : nlohmann::json()},
+                           {"validated_feasible", r.validation ? nlohmann::json(r.validation_feasible) : nlohmann::json()},
                            {"wall_time_s", r.result.wall_time_s}});
     j["files"] = files.files;
     j["skipped_plots"] = files.skipped_plots;

@@ -37,7 +37,8 @@ std::unique_ptr<opt::Problem> make_benchmark(const std::string& name, const Benc
     throw ConfigError("benchmark", name, "unknown benchmark problem; valid: " + valid);
   }
   if (!noisy) return base;
-  return std::make_unique<NoisyProblem>(std::move(base), settings.noise_amplitude, settings.noise_seed);
+  return std::make_unique<NoisyProblem>(std::move(base), settings.noise_amplitude, settings.noise_seed,
+                                        settings.noise_samples);
 }
 
 }  // namespace abuopt::opt::benchmarks

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <cstring>
+#include <stdexcept>
+#include <string>
 
 #include "abuopt/common/config_error.hpp"
 
@@ -16,10 +18,13 @@ std::uint64_t splitmix64(std::uint64_t z) {
 }
 }  // namespace
 
-NoisyProblem::NoisyProblem(std::unique_ptr<opt::Problem> inner, double amplitude, std::uint64_t seed)
-    : inner_(std::move(inner)), amplitude_(amplitude), seed_(seed) {
+NoisyProblem::NoisyProblem(std::unique_ptr<opt::Problem> inner, double amplitude, std::uint64_t seed,
+                           std::size_t samples)
+    : inner_(std::move(inner)), amplitude_(amplitude), seed_(seed), samples_(samples) {
   if (!(amplitude >= 0.0 && amplitude < 1.0))
     throw ConfigError("noise_amplitude", opt::format_number(amplitude), "must be in [0, 1)");
+  if (samples > (std::size_t{1} << 24))
+    throw ConfigError("noise_samples", std::to_string(samples), "must be in [0, 2^24] (0: not sampled)");
 }
 
 double NoisyProblem::unit_noise(const std::vector<double>& x, std::uint64_t seed, std::uint64_t k) {
@@ -33,9 +38,33 @@ double NoisyProblem::unit_noise(const std::vector<double>& x, std::uint64_t seed
 }
 
 opt::Evaluation NoisyProblem::evaluate(const std::vector<double>& x) {
+  if (samples_ > 0) return evaluate_sampled(x, samples_);
   opt::Evaluation e = inner_->evaluate(x);
   if (!e.ok || amplitude_ == 0.0) return e;
   auto noisy = [&](double v, std::uint64_t k) { return v + amplitude_ * (1.0 + std::fabs(v)) * unit_noise(x, seed_, k); };
+  e.metrics["noise_free_objective"] = e.objective;
+  e.objective = noisy(e.objective, 0);
+  std::uint64_t k = 1;
+  for (double& g : e.inequality) g = noisy(g, k++);
+  for (double& h : e.equality) h = noisy(h, k++);
+  return e;
+}
+
+opt::Evaluation NoisyProblem::evaluate_sampled(const std::vector<double>& x, std::size_t n, std::size_t) {
+  if (samples_ == 0) return opt::Problem::evaluate_sampled(x, n);  // not sampled: n must be 0
+  if (n < 1 || n > samples_)
+    throw std::invalid_argument("NoisyProblem::evaluate_sampled: n = " + std::to_string(n) + " is outside [1, " +
+                                std::to_string(samples_) + "]");
+  opt::Evaluation e = inner_->evaluate(x);
+  e.metrics["runs"] = static_cast<double>(n);
+  if (!e.ok || amplitude_ == 0.0) return e;
+  // the mean of the first n runs' noise (variance 1 each): run i of output k has its own stream
+  auto mean_noise = [&](std::uint64_t k) {
+    double sum = 0;
+    for (std::size_t i = 0; i < n; ++i) sum += unit_noise(x, splitmix64(seed_ ^ splitmix64(0xC0FFEEULL + i)), k);
+    return std::sqrt(3.0) * sum / static_cast<double>(n);
+  };
+  auto noisy = [&](double v, std::uint64_t k) { return v + amplitude_ * (1.0 + std::fabs(v)) * mean_noise(k); };
   e.metrics["noise_free_objective"] = e.objective;
   e.objective = noisy(e.objective, 0);
   std::uint64_t k = 1;

@@ -29,5 +29,8 @@ AdapterOutcome run_ipopt(EvaluationDriver& driver, const OptimizerOptions& optio
 // driver).
 AdapterOutcome run_sao(EvaluationDriver& driver, Problem& problem, const OptimizerOptions& options,
                        const std::vector<double>& x0);
+// SAO's sample size schedule against the problem (sao_sampling.cpp), before the run: ConfigError
+// naming sao.samples.* when the problem's sample size cannot be chosen or is too small.
+void check_sao_sampling(const Problem& problem, const SaoOptions& sao);
 
 }  // namespace abuopt::opt::detail

@@ -21,6 +21,7 @@
 #include "abuopt/common/text.hpp"
 #include "abuopt/optimizer/algorithms.hpp"
 #include "abuopt/optimizer/minimize.hpp"
+#include "abuopt/optimizer/two_stage.hpp"
 
 namespace abuopt::opt {
 
@@ -77,6 +78,14 @@ SolverSpec read_solver_spec(YamlReader& r) {
     if (find_algorithm(algorithm, r.key_path("algorithm")).name != "SAO")
       throw ConfigError(r.key_path("sao"), "<section>", "only for algorithm sao (this solver is " + algorithm + ")");
     s.options.sao = read_sao_options(sao);
+  }
+  YamlReader then = r.child("then");
+  if (then.present()) {
+    if (then.has("then")) throw ConfigError(then.key_path("then"), "<section>", "two stages at most");
+    SolverSpec second = read_solver_spec(then);
+    s.then = second.options;
+    s.first_fraction = r.get_double_or("first_fraction", s.first_fraction, Rule::in_range(1e-6, 1 - 1e-6));
+    s.penalty_weight = r.get_double_or("penalty_weight", s.penalty_weight, Rule::positive());
   }
   r.finish();
   return s;
@@ -178,6 +187,7 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
     if (!labels.insert(s.label).second) throw ConfigError("compare.solvers", s.label, "duplicate solver label");
     if (find_algorithm(s.options.algorithm).name == "SAO") s.options.sao.validate("compare.solvers[" + s.label + "].sao");
     s.options.validate();
+    if (s.then) s.then->validate();
   }
 
   ComparisonResult out;
@@ -212,7 +222,20 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
         rec.dimension = problem->dimension();
         rec.x0 = starts[k];
         try {
-          rec.result = minimize(*problem, o, starts[k]);
+          if (solver.then) {
+            TwoStageOptions two;
+            two.first = o;
+            two.then = *solver.then;
+            two.then.constraint_tolerance = o.constraint_tolerance;
+            two.then.seed = o.seed;
+            two.then.handle_sigint = o.handle_sigint;
+            if (setup.threads > 1 && two.then.evaluation_threads == 0) two.then.evaluation_threads = 1;
+            two.first_fraction = solver.first_fraction;
+            two.penalty_weight = solver.penalty_weight;
+            rec.result = minimize_two_stage(*problem, two, spec.max_evaluations, starts[k]);
+          } else {
+            rec.result = minimize(*problem, o, starts[k]);
+          }
         } catch (const ConfigError& e) {
           // e.g. a bound-only global algorithm on a constrained problem: recorded as a failed run
           rec.result.problem_name = problem->name();
@@ -231,6 +254,14 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
         }
         rec.best_true_objective = best;
         rec.feasible = std::isfinite(best);
+        if (spec.validate && !rec.result.x.empty()) {
+          try {
+            rec.validation = spec.validate(rec.result.x);
+          } catch (const std::exception& e) {
+            rec.validation = Evaluation::failed(std::string("validation threw: ") + e.what());
+          }
+          rec.validation_feasible = is_feasible(*rec.validation, spec.constraint_tolerance);
+        }
         out.runs[first_run + t] = std::move(rec);
       }
     };
@@ -367,7 +398,8 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
   {
     OutFile f(dir / "runs.csv", written);
     f << "problem,start,solver,algorithm,dimension,x0,reason,best_true_objective,feasible,objective,max_violation,"
-         "evaluations,evaluations_to_tau,f_star,wall_time_s,message\n";
+         "evaluations,evaluations_to_tau,f_star,wall_time_s,samples,validated_objective,validated_max_violation,"
+         "validated_feasible,message\n";
     for (const RunRecord& run : r.runs) {
       std::string x0;
       for (double v : run.x0) x0 += (x0.empty() ? "" : " ") + format_number(v);
@@ -378,7 +410,13 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
         << "," << csv_number(run.best_true_objective) << "," << (run.feasible ? 1 : 0) << ","
         << csv_number(run.result.objective) << "," << csv_number(run.result.max_violation) << ","
         << run.result.evaluations << "," << run.evaluations_to_solve << "," << csv_number(r.f_star[p]) << ","
-        << csv_number(run.result.wall_time_s) << "," << csv_text(run.result.message) << "\n";
+        << csv_number(run.result.wall_time_s) << "," << run.result.samples << ",";
+      if (run.validation)
+        f << csv_number(run.validation->objective) << "," << csv_number(max_constraint_violation(*run.validation)) << ","
+          << (run.validation_feasible ? 1 : 0) << ",";
+      else
+        f << ",,,";
+      f << csv_text(run.result.message) << "\n";
     }
     f.commit();
   }

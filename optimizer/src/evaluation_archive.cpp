@@ -496,27 +496,44 @@ ArchivedProblem::ArchivedProblem(Problem& inner, EvaluationArchive& archive) : i
 Evaluation ArchivedProblem::evaluate(const std::vector<double>& x) { return evaluate_shared(x, 1); }
 
 Evaluation ArchivedProblem::evaluate_shared(const std::vector<double>& x, std::size_t concurrent) {
-  if (std::optional<Evaluation> hit = archive_.find(x)) {
+  return evaluate_sampled(x, inner_.sample_size(), concurrent);
+}
+
+long ArchivedProblem::runs_key(std::size_t n) const {
+  return n == inner_.sample_size() ? 0 : static_cast<long>(n);
+}
+
+Evaluation ArchivedProblem::evaluate_sampled(const std::vector<double>& x, std::size_t n, std::size_t concurrent) {
+  const long runs = runs_key(n);
+  if (std::optional<Evaluation> hit = archive_.find(x, runs)) {
     ++hits_;
     return *hit;
   }
   const auto t0 = std::chrono::steady_clock::now();
   // an exception propagates and nothing is stored
-  Evaluation e = concurrent > 1 ? inner_.evaluate_shared(x, concurrent) : inner_.evaluate(x);
+  Evaluation e = runs != 0             ? inner_.evaluate_sampled(x, n, concurrent)
+                 : concurrent > 1      ? inner_.evaluate_shared(x, concurrent)
+                                       : inner_.evaluate(x);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   e.from_archive = false;
-  archive_.store(x, e, wall);
+  archive_.store(x, e, wall, runs);
   ++misses_;
   return e;
 }
 
 std::vector<BatchEvaluation> ArchivedProblem::evaluate_batch(const std::vector<std::vector<double>>& xs,
                                                              EvaluationScheduler& scheduler) {
+  return evaluate_batch_sampled(xs, inner_.sample_size(), scheduler);
+}
+
+std::vector<BatchEvaluation> ArchivedProblem::evaluate_batch_sampled(const std::vector<std::vector<double>>& xs,
+                                                                     std::size_t n, EvaluationScheduler& scheduler) {
+  const long runs = runs_key(n);
   std::vector<BatchEvaluation> out(xs.size());
   std::vector<std::size_t> miss;
   std::vector<std::vector<double>> miss_x;
   for (std::size_t i = 0; i < xs.size(); ++i) {
-    if (std::optional<Evaluation> hit = archive_.find(xs[i])) {
+    if (std::optional<Evaluation> hit = archive_.find(xs[i], runs)) {
       ++hits_;
       out[i].evaluation = std::move(*hit);
     } else {
@@ -525,12 +542,13 @@ std::vector<BatchEvaluation> ArchivedProblem::evaluate_batch(const std::vector<s
     }
   }
   if (miss.empty()) return out;
-  std::vector<BatchEvaluation> computed = inner_.evaluate_batch(miss_x, scheduler);
+  std::vector<BatchEvaluation> computed =
+      runs != 0 ? inner_.evaluate_batch_sampled(miss_x, n, scheduler) : inner_.evaluate_batch(miss_x, scheduler);
   for (std::size_t k = 0; k < miss.size(); ++k) {
     BatchEvaluation& b = computed[k];
     if (!b.error) {  // a point whose evaluation threw is not stored
       b.evaluation.from_archive = false;
-      archive_.store(miss_x[k], b.evaluation, b.wall_time_s);
+      archive_.store(miss_x[k], b.evaluation, b.wall_time_s, runs);
       ++misses_;
     }
     out[miss[k]] = std::move(b);

@@ -57,6 +57,7 @@ EvaluationDriver::EvaluationDriver(Problem& problem, const OptimizerOptions& opt
       n_ineq_(problem.inequality_names().size()),
       n_eq_(problem.equality_names().size()),
       start_(std::chrono::steady_clock::now()) {
+  default_sample_size_ = sample_size_ = problem.sample_size();
   scheduler_ = options.scheduler ? options.scheduler : std::make_shared<ThreadScheduler>(options.evaluation_threads);
   for (const Variable& v : variables_) {
     lower_y_.push_back(v.lower / v.scale);
@@ -66,6 +67,14 @@ EvaluationDriver::EvaluationDriver(Problem& problem, const OptimizerOptions& opt
   fd_step_ = options.fd_relative_step > 0 ? options.fd_relative_step
              : options.finite_difference == FiniteDifference::Central ? std::cbrt(eps)
                                                                         : std::sqrt(eps);
+}
+
+void EvaluationDriver::set_sample_size(std::size_t n) {
+  if (n == 0) n = default_sample_size_;
+  if (n != default_sample_size_ && (n < 1 || n > problem_.max_sample_size()))
+    throw std::invalid_argument("EvaluationDriver::set_sample_size: " + std::to_string(n) + " is outside [1, " +
+                                std::to_string(problem_.max_sample_size()) + "] for problem '" + problem_.name() + "'");
+  sample_size_ = n;
 }
 
 std::vector<double> EvaluationDriver::to_scaled(const std::vector<double>& x) const {
@@ -136,13 +145,15 @@ std::vector<const EvaluatedPoint*> EvaluationDriver::evaluate_batch(const std::v
   std::vector<Item> items(ys.size());
   std::vector<std::vector<double>> fresh;
   std::map<std::vector<double>, std::size_t> in_batch;  // x -> slot of its first occurrence
+  const std::size_t n_samples = sample_size_;
+  const bool own_size = n_samples == default_sample_size_;  // evaluate() as without sampling
   bool refused = check_limits();
   for (std::size_t i = 0; i < ys.size(); ++i) {
     if (ys[i].size() != variables_.size())
       throw std::invalid_argument("EvaluationDriver::evaluate_batch: a point of the wrong size");
     Item& it = items[i];
     it.x = clip(ys[i].data(), it.clipped);
-    if (index_.count(it.x) || in_batch.count(it.x)) {
+    if (index_.count(Key(n_samples, it.x)) || in_batch.count(it.x)) {
       it.kind = Kind::Repeat;
       continue;
     }
@@ -166,13 +177,14 @@ std::vector<const EvaluatedPoint*> EvaluationDriver::evaluate_batch(const std::v
       computed.resize(1);
       const auto t0 = std::chrono::steady_clock::now();
       try {
-        computed[0].evaluation = problem_.evaluate(fresh[0]);
+        computed[0].evaluation = own_size ? problem_.evaluate(fresh[0]) : problem_.evaluate_sampled(fresh[0], n_samples);
       } catch (...) {
         computed[0].error = std::current_exception();
       }
       computed[0].wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     } else {
-      computed = problem_.evaluate_batch(fresh, *scheduler_);
+      computed = own_size ? problem_.evaluate_batch(fresh, *scheduler_)
+                          : problem_.evaluate_batch_sampled(fresh, n_samples, *scheduler_);
       if (computed.size() != fresh.size())
         throw std::logic_error("Problem::evaluate_batch returned " + std::to_string(computed.size()) +
                                " results for " + std::to_string(fresh.size()) + " points");
@@ -183,7 +195,7 @@ std::vector<const EvaluatedPoint*> EvaluationDriver::evaluate_batch(const std::v
   std::vector<const EvaluatedPoint*> out(ys.size(), nullptr);
   for (std::size_t i = 0; i < items.size(); ++i) {
     Item& it = items[i];
-    if (auto found = index_.find(it.x); found != index_.end()) {
+    if (auto found = index_.find(Key(n_samples, it.x)); found != index_.end()) {
       ++repeats_;
       out[i] = &points_[found->second];
       continue;
@@ -200,6 +212,7 @@ const EvaluatedPoint* EvaluationDriver::record(std::vector<double> x, bool clipp
   if (clipped) ++clipped_;
   EvaluatedPoint p;
   p.x = x;
+  p.samples = sample_size_;
   bool threw = false;
   if (b.error) {
     threw = true;
@@ -247,18 +260,22 @@ const EvaluatedPoint* EvaluationDriver::record(std::vector<double> x, bool clipp
       if (std::isfinite(h)) max_abs_constraint_ = std::max(max_abs_constraint_, std::fabs(h));
   }
   ++evaluations_;
+  samples_ += static_cast<long>(p.samples);
   if (p.e.from_archive) ++archive_hits_;
   if (!p.e.ok) ++failed_;
   if (for_gradient) ++gradient_evals_;
 
   points_.push_back(std::move(p));
   const std::size_t idx = points_.size() - 1;
-  index_.emplace(x, idx);
+  index_.emplace(Key(points_.back().samples, x), idx);
   const EvaluatedPoint& stored = points_.back();
 
   // best: feasible with lowest f; else the smallest violation among ok points; else anything.
+  // Between feasible points of different sample sizes (adaptive sampling) the larger sample wins:
+  // a value on few runs is the noisier estimate, and the result is the estimate on the most runs.
   auto better = [&](const EvaluatedPoint& a, const EvaluatedPoint& b) {
     if (a.feasible != b.feasible) return a.feasible;
+    if (a.feasible && a.samples != b.samples) return a.samples > b.samples;
     if (a.feasible) return a.e.objective < b.e.objective;
     if (a.e.ok != b.e.ok) return a.e.ok;
     return a.violation < b.violation;
@@ -429,6 +446,7 @@ bool EvaluationDriver::derivatives(const double* y_in, const EvaluatedPoint& bas
 
 void EvaluationDriver::fill(OptimizationResult& r) const {
   r.evaluations = evaluations_;
+  r.samples = samples_;
   r.archive_hits = archive_hits_;
   r.failed_evaluations = failed_;
   r.gradient_evaluations = gradient_evals_;

@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,7 @@ class SigintGuard {
 
 struct EvaluatedPoint {
   std::vector<double> x;  // real units, inside the bounds
+  std::size_t samples = 0;  // the sample size it was evaluated at (0: not a sampled problem)
   Evaluation e;
   double violation = 0.0;
   bool feasible = false;
@@ -76,6 +78,18 @@ class EvaluationDriver {
   // Returns false if the run stopped meanwhile (the outputs are then partial).
   bool derivatives(const double* y, const EvaluatedPoint& base, double* grad_f, double* jac_ineq, double* jac_eq);
 
+  // Sample size of the evaluations from now on (problem.hpp evaluate_sampled; docs/sao.md
+  // "Adaptive sample size"): 0 or the problem's own sample_size() evaluate as evaluate() does;
+  // another n in [1, max_sample_size()] by evaluate_sampled(x, n) (std::invalid_argument
+  // otherwise). A point is known per (x, sample size): the same x at another n is a new evaluation.
+  void set_sample_size(std::size_t n);
+  // The sample size evaluations use now: the problem's own sample_size() unless set.
+  std::size_t sample_size() const { return sample_size_; }
+  std::size_t max_sample_size() const { return problem_.max_sample_size(); }
+  std::size_t default_sample_size() const { return default_sample_size_; }
+  // Sum of the sample sizes of the evaluations counted so far (Monte Carlo runs).
+  long samples() const { return samples_; }
+
   bool stopped() const { return stop_reason_.has_value(); }
   std::optional<TerminationReason> stop_reason() const { return stop_reason_; }
   const std::string& stop_message() const { return stop_message_; }
@@ -112,7 +126,10 @@ class EvaluationDriver {
   std::chrono::steady_clock::time_point start_;
 
   std::deque<EvaluatedPoint> points_;
-  std::map<std::vector<double>, std::size_t> index_;  // x (real units) -> points_
+  using Key = std::pair<std::size_t, std::vector<double>>;  // (sample size, x in real units)
+  std::map<Key, std::size_t> index_;                          // -> points_
+  std::size_t default_sample_size_ = 0, sample_size_ = 0;
+  long samples_ = 0;
   std::optional<std::size_t> best_;
   std::vector<EvaluationRecord> history_;
 

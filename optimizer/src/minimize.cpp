@@ -59,6 +59,8 @@ OptimizationResult minimize(Problem& problem, const OptimizerOptions& options, s
                       (too_few(algorithm) ? algorithm.name : local->name) +
                           " needs at least 2 variables; problem '" + problem.name() + "' has 1 (use COBYLA or SBPLX)");
 
+  if (algorithm.name == "SAO") detail::check_sao_sampling(problem, options.sao);
+
   // ---- the run: from here on nothing throws; the best point so far is always returned ----
   detail::SigintGuard sigint(options.handle_sigint);
   detail::interrupt_flag().store(false);

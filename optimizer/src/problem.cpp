@@ -37,15 +37,26 @@ std::vector<double> Problem::initial_point() const {
 
 Evaluation Problem::evaluate_shared(const std::vector<double>& x, std::size_t) { return evaluate(x); }
 
-std::vector<BatchEvaluation> Problem::evaluate_batch(const std::vector<std::vector<double>>& xs,
-                                                     EvaluationScheduler& scheduler) {
+Evaluation Problem::evaluate_sampled(const std::vector<double>& x, std::size_t n, std::size_t concurrent) {
+  if (n != sample_size())
+    throw std::invalid_argument("Problem::evaluate_sampled: problem '" + name() + "' is evaluated at " +
+                                std::to_string(sample_size()) + " samples only, asked for " + std::to_string(n));
+  return concurrent > 1 ? evaluate_shared(x, concurrent) : evaluate(x);
+}
+
+namespace {
+// The scheduling of Problem::evaluate_batch: `one(x, share)` evaluates a point as one of `share`
+// evaluations at once (share 1: alone, on the calling thread).
+template <class One>
+std::vector<BatchEvaluation> run_batch(const Problem& problem, const std::vector<std::vector<double>>& xs,
+                                       EvaluationScheduler& scheduler, One one_point) {
   std::vector<BatchEvaluation> out(xs.size());
-  const bool concurrent = thread_safe() && xs.size() > 1 && scheduler.concurrency() > 1;
+  const bool concurrent = problem.thread_safe() && xs.size() > 1 && scheduler.concurrency() > 1;
   const std::size_t share = concurrent ? std::min(xs.size(), scheduler.concurrency()) : 1;
   auto one = [&](std::size_t i) {
     const auto t0 = std::chrono::steady_clock::now();
     try {
-      out[i].evaluation = concurrent ? evaluate_shared(xs[i], share) : evaluate(xs[i]);
+      out[i].evaluation = one_point(xs[i], share);
     } catch (...) {
       out[i].error = std::current_exception();
     }
@@ -56,6 +67,22 @@ std::vector<BatchEvaluation> Problem::evaluate_batch(const std::vector<std::vect
   else
     for (std::size_t i = 0; i < xs.size(); ++i) one(i);
   return out;
+}
+}  // namespace
+
+std::vector<BatchEvaluation> Problem::evaluate_batch(const std::vector<std::vector<double>>& xs,
+                                                     EvaluationScheduler& scheduler) {
+  return run_batch(*this, xs, scheduler, [this](const std::vector<double>& x, std::size_t share) {
+    return share > 1 ? evaluate_shared(x, share) : evaluate(x);
+  });
+}
+
+std::vector<BatchEvaluation> Problem::evaluate_batch_sampled(const std::vector<std::vector<double>>& xs,
+                                                             std::size_t n, EvaluationScheduler& scheduler) {
+  if (n == sample_size()) return evaluate_batch(xs, scheduler);
+  return run_batch(*this, xs, scheduler, [this, n](const std::vector<double>& x, std::size_t share) {
+    return evaluate_sampled(x, n, share);
+  });
 }
 
 FunctionProblem::FunctionProblem(std::string name, std::vector<Variable> variables, Function function,

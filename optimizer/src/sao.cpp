@@ -14,9 +14,10 @@ namespace abuopt::opt {
 
 namespace detail {
 
-KnownPoint SaoRun::make_point(const Eigen::VectorXd& z, const Evaluation& e) const {
+KnownPoint SaoRun::make_point(const Eigen::VectorXd& z, const Evaluation& e, std::size_t samples) const {
   KnownPoint p;
   p.z = z;
+  p.samples = samples;
   p.ok = e.ok && std::isfinite(e.objective) && e.inequality.size() == m_ineq_ && e.equality.size() == m_eq_;
   p.f = p.ok ? e.objective : kInf;
   p.g = e.inequality;
@@ -37,7 +38,7 @@ std::optional<std::size_t> SaoRun::evaluate(const Eigen::VectorXd& z) {
   const EvaluatedPoint* p = driver_.evaluate(y.data());
   if (!p) return std::nullopt;
   if (auto it = by_driver_point_.find(p); it != by_driver_point_.end()) return it->second;
-  known_.push_back(make_point(to_z(p->x), p->e));
+  known_.push_back(make_point(to_z(p->x), p->e, p->samples));
   by_driver_point_.emplace(p, known_.size() - 1);
   return known_.size() - 1;
 }
@@ -51,7 +52,8 @@ void SaoRun::load_archive() {
       inside = inside && std::isfinite(entry.x[i]) && entry.x[i] >= variables_[i].lower &&
                entry.x[i] <= variables_[i].upper;
     if (!inside) continue;
-    known_.push_back(make_point(to_z(entry.x), entry.evaluation));
+    const std::size_t samples = entry.runs == 0 ? driver_.default_sample_size() : static_cast<std::size_t>(entry.runs);
+    known_.push_back(make_point(to_z(entry.x), entry.evaluation, samples));
   }
 }
 
@@ -65,6 +67,7 @@ double SaoRun::merit_noise(const Models& models, bool phase1) const {
 void SaoRun::run(const std::vector<double>& x0) {
   load_archive();
   radius_ = sao_.initial_radius;
+  start_sampling();
   centre_z_ = to_z(x0);
   const auto c0 = evaluate(centre_z_);
   if (!c0) return;
@@ -95,6 +98,7 @@ void SaoRun::run(const std::vector<double>& x0) {
       message = "iteration limit of " + std::to_string(options_.max_iterations) + " reached";
       return;
     }
+    if (sampling_ && !update_sample_size()) return;
     ++iterations;
 
     IterationRecord record;
@@ -125,8 +129,11 @@ void SaoRun::run(const std::vector<double>& x0) {
     noise_confirmation_.confirm(models->noise, models->noise_fraction, radius_);
     // noise measured by the probe holds whatever the fit says (the residuals of a fit that
     // interpolates, or of too few points, say nothing)
+    // (measured at probed_samples_ runs: its standard error scales as 1 / sqrt(n))
+    const double probe_scale =
+        sampling_ && probed_samples_ > 0 ? std::sqrt(double(probed_samples_) / double(samples_)) : 1.0;
     for (std::size_t k = 0; k < probed_noise_.size() && k < models->noise.size(); ++k)
-      models->noise[k] = std::max(models->noise[k], probed_noise_[k]);
+      models->noise[k] = std::max(models->noise[k], probe_scale * probed_noise_[k]);
     bool phase1 = false;
     const Eigen::VectorXd s = solve_subproblem(*models, phase1);
     feasibility_phase_ = phase1;
@@ -187,6 +194,10 @@ void SaoRun::run(const std::vector<double>& x0) {
         radius_ = std::max(radius_, streak_radius);
       }
     }
+    // Adaptive sample size: a failed step whose shortfall is within the noise of a difference of
+    // two merits (sqrt 2 sigma), or exactly flat, could be noise: more runs tell the next time.
+    if (sampling_ && failed && !repeated && (predicted - actual <= std::sqrt(2.0) * sigma || flat))
+      double_samples_for_noise();
     if (!(actual > 0)) {
       if (!within_noise) radius_ *= sao_.shrink_factor;  // rejected: keep the centre
     } else {

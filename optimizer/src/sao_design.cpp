@@ -191,7 +191,7 @@ bool SaoRun::fill_region(SurrogateKind basis) {
       if (auto it = by_driver_point_.find(p); it != by_driver_point_.end()) {
         idx = it->second;
       } else {
-        known_.push_back(make_point(to_z(p->x), p->e));
+        known_.push_back(make_point(to_z(p->x), p->e, p->samples));
         idx = known_.size() - 1;
         by_driver_point_.emplace(p, idx);
       }

@@ -33,11 +33,12 @@ std::optional<Models> SaoRun::fit(SurrogateKind requested) {
   std::vector<const KnownPoint*> pts;
   for (const KnownPoint& p : known_) {
     if (!p.fits()) continue;
+    if (sampling_ && !fit_value(p, 0)) continue;  // a sample size the run cannot shift
     const Eigen::VectorXd sp = to_s(p.z);
     const double d = sp.cwiseAbs().maxCoeff();
     if (d > sao_.neighbourhood * (1 + 1e-9)) continue;
     s.push_back(sp);
-    w.push_back(d <= 1 + 1e-9 ? 1.0 : 1.0 / std::pow(d, 4));
+    w.push_back((d <= 1 + 1e-9 ? 1.0 : 1.0 / std::pow(d, 4)) * sample_weight(p));
     pts.push_back(&p);
   }
   const int m = static_cast<int>(s.size());
@@ -82,7 +83,7 @@ std::optional<Models> SaoRun::fit(SurrogateKind requested) {
       std::vector<double> noise(responses, 0.0), noise_fraction(responses, 0.0);
       auto fit_one = [&](std::size_t k, const std::function<double(const KnownPoint&)>& value) {
         Eigen::VectorXd y(m);
-        for (int i = 0; i < m; ++i) y[i] = value(*pts[i]);
+        for (int i = 0; i < m; ++i) y[i] = sampling_ ? *fit_value(*pts[i], k) : value(*pts[i]);
         if (kriging) {
           // kriging interpolates: region points and neighbours alike; intervening variables only
           // when asked for explicitly (no leave-one-out error to choose them by)

@@ -71,6 +71,7 @@ std::optional<bool> SaoRun::probe_noise(double predicted, bool phase1) {
   const double sigma = detail::merit_noise(noise, c.g, m_ineq_, m_eq_, mu_, phase1);
   if (kProbeRatio * sigma >= predicted) {
     probed_noise_ = noise;
+    probed_samples_ = samples_;
     return true;
   }
   return smooth();

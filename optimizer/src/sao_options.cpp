@@ -122,6 +122,13 @@ void SaoOptions::validate(const std::string& p) const {
           "must be 0 (no global phase) or >= 2");
   require(global_phase.iterations == 0 || global_phase.points > 0, p + ".global_phase", "iterations",
           global_phase.iterations, "needs global_phase.points > 0 (the design the infill starts from)");
+  require(samples.initial >= 0, p + ".samples", "initial", samples.initial, "must be 0 (off) or >= 1");
+  require(samples.max == 0 || (samples.initial > 0 && samples.max >= samples.initial), p + ".samples", "max",
+          samples.max,
+          samples.initial > 0 ? "must be 0 (the problem's largest) or >= samples.initial = " + std::to_string(samples.initial)
+                              : std::string("needs samples.initial >= 1 (the schedule is off)"));
+  require(std::isfinite(samples.exponent) && samples.exponent >= 0 && samples.exponent <= 8, p + ".samples",
+          "exponent", samples.exponent, "must be in [0, 8]");
   if (surrogate == SurrogateKind::Quadratic && doe == DoeKind::Koshal)
     throw ConfigError(p + ".doe", to_string(doe), "koshal (n+1 points) cannot determine a quadratic surrogate; use auto, axial, "
                                        "central_composite or lhs");
@@ -188,6 +195,15 @@ void describe_fields(FieldArchive& a, SaoOptions& o) {
   a.field("subproblem_max_evaluations", o.subproblem_max_evaluations, Rule::in_range(10, 1e7));
   a.field("kriging_nugget", o.kriging_nugget);
   a.nested("global_phase", o.global_phase);
+  FieldOptions sampling;
+  sampling.enabled = a.reading() || o.samples.enabled();  // written only when on (older outputs unchanged)
+  a.nested("samples", o.samples, sampling);
+}
+
+void describe_fields(FieldArchive& a, SaoSampling& o) {
+  a.field("initial", o.initial, Rule::in_range(0, 1 << 30));
+  a.field("max", o.max, Rule::in_range(0, 1 << 30));
+  a.field("exponent", o.exponent);
 }
 
 void describe_fields(FieldArchive& a, SaoGlobalPhase& o) {

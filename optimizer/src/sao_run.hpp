@@ -3,7 +3,8 @@
 // in their own files: sao.cpp (the iteration loop, the ratio test, points), sao_design.cpp (the
 // points of a region), sao_models.cpp (the surrogates), sao_subproblem.cpp (the sub-problem and the
 // penalty), sao_noise.cpp (the noise estimate of the ratio test), sao_global.cpp (the optional
-// global phase before the trust region), sao_noise_probe.cpp (noise detected from the data).
+// global phase before the trust region), sao_noise_probe.cpp (noise detected from the data),
+// sao_sampling.cpp (the adaptive sample size).
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -38,6 +39,7 @@ struct KnownPoint {
   bool ok = false;
   double l1_violation = kInf;  // sum max(0, g) + sum |h|
   double runs = 0;             // the evaluation's metric "runs" (Monte Carlo runs), 0 without it
+  std::size_t samples = 0;     // the sample size it was evaluated at (0: not a sampled problem)
   // a point of a noise probe that found no noise: it stays known (never evaluated again) but does
   // not enter the fits, so that a probe on a smooth problem changes nothing but the count
   bool probe_only = false;
@@ -144,12 +146,29 @@ class SaoRun {
   // ---- points (sao.cpp) ----
   // Evaluates z on the true problem; the index into known_, or nullopt once the run is stopped.
   std::optional<std::size_t> evaluate(const Eigen::VectorXd& z);
-  KnownPoint make_point(const Eigen::VectorXd& z, const Evaluation& e) const;
+  KnownPoint make_point(const Eigen::VectorXd& z, const Evaluation& e, std::size_t samples) const;
   double merit(const KnownPoint& p) const {
     if (!p.ok) return kInf;
     return feasibility_phase_ ? p.l1_violation : p.f + mu_ * p.l1_violation;
   }
   void load_archive();
+
+  // ---- sample size (sao_sampling.cpp; docs/sao.md "Adaptive sample size") ----
+  // Checks the schedule against the problem and sets the first sample size (before any evaluation).
+  void start_sampling();
+  // The schedule's size for the current radius (n_k of SaoSampling without the floor and monotonicity).
+  std::size_t scheduled_samples() const;
+  // Raises the sample size to the schedule's and, if it grew, evaluates the centre again at the
+  // new size and records the shift of every response (false: stopped).
+  bool update_sample_size();
+  // The value of response k (0 objective, then inequalities, equalities) of p as the fits see it:
+  // its own value plus the shift from its sample size to the current one; nullopt when no shift is
+  // known for its size (a point of another size from an archive).
+  std::optional<double> fit_value(const KnownPoint& p, std::size_t k) const;
+  // Weight factor of p in the fits: its sample size over the current one (1 without sampling).
+  double sample_weight(const KnownPoint& p) const;
+  // A failed step whose shortfall the noise of a merit difference explains: the floor doubles.
+  void double_samples_for_noise();
 
   // ---- the points of a region (sao_design.cpp) ----
   int wanted_points(SurrogateKind basis) const;
@@ -203,6 +222,13 @@ class SaoRun {
   bool noisy_ = false;
   double last_probe_radius_ = kInf;
   std::vector<double> probed_noise_;  // per response, set when the probe finds noise
+  std::size_t probed_samples_ = 0;    // the sample size the probe's noise was measured at
+
+  // adaptive sample size (off: samples_ stays the problem's own size and nothing is shifted)
+  bool sampling_ = false;
+  std::size_t samples_ = 0, samples_min_ = 0, samples_max_ = 0, samples_floor_ = 0;
+  // per smaller sample size: what to add to each response's value to express it at samples_
+  std::map<std::size_t, std::vector<double>> shift_to_current_;
 };
 
 }  // namespace abuopt::opt::detail

@@ -370,6 +370,34 @@ opt::Evaluation StartupProfileProblem::evaluate_shared(const std::vector<double>
                                share);
 }
 
+std::size_t StartupProfileProblem::max_sample_size() const {
+  switch (settings_.study.design.kind) {
+    case InitialConditionKind::Random:
+    case InitialConditionKind::Halton:
+    case InitialConditionKind::Sobol: return settings_.study.runs;
+    case InitialConditionKind::Grid:
+    case InitialConditionKind::LatinHypercube: return 0;
+  }
+  return 0;
+}
+
+opt::Evaluation StartupProfileProblem::evaluate_sampled(const std::vector<double>& x, std::size_t n,
+                                                        std::size_t concurrent) {
+  if (n == settings_.study.runs) return concurrent > 1 ? evaluate_shared(x, concurrent) : evaluate(x);
+  if (n < 1 || n > max_sample_size())
+    throw std::invalid_argument("StartupProfileProblem::evaluate_sampled: n = " + std::to_string(n) +
+                                " is outside [1, " + std::to_string(max_sample_size()) + "] (montecarlo.design " +
+                                to_string(settings_.study.design.kind) + ", runs " +
+                                std::to_string(settings_.study.runs) + ")");
+  if (x.size() != variables_.size())
+    return opt::Evaluation::failed("the problem has " + std::to_string(variables_.size()) +
+                                   " variables, the design vector has " + std::to_string(x.size()));
+  const std::size_t all = settings_.threads == 0 ? hardware_threads() : settings_.threads;
+  const std::size_t threads =
+      concurrent > 1 ? std::max<std::size_t>(1, all / concurrent) : settings_.threads;
+  return evaluate_with_threads(profile_at(x), settings_.study.design, n, settings_.study.seed, threads);
+}
+
 opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& profile) const {
   return evaluate_profile(profile, settings_.study.design, settings_.study.runs, settings_.study.seed);
 }

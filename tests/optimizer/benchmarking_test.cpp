@@ -233,3 +233,54 @@ TEST(Comparison, ReadSolverSpec) {
 }
 
 }  // namespace
+
+// Out-of-sample validation and simulation counts: ProblemSpec::validate is called on every run's
+// result (here the noise-free hs071 at the result of a run on its sampled noisy variant), and
+// runs.csv carries samples, validated_objective, validated_max_violation and validated_feasible.
+TEST(Comparison, ValidatesEveryResultAndCountsSimulations) {
+  opt::ComparisonSetup setup;
+  opt::ProblemSpec spec;
+  spec.label = "sampled_hs071";
+  spec.make = [] {
+    opt::benchmarks::BenchmarkSettings s;
+    s.noise_amplitude = 0.01;
+    s.noise_samples = 32;
+    return opt::benchmarks::make_benchmark("noisy_hs071", s);
+  };
+  spec.max_evaluations = 40;
+  spec.starts = 2;
+  spec.constraint_tolerance = 1e-2;
+  int validated = 0;
+  spec.validate = [&validated](const std::vector<double>& x) {
+    ++validated;
+    return opt::benchmarks::make_benchmark("hs071")->evaluate(x);
+  };
+  setup.problems.push_back(spec);
+  setup.solvers.push_back(opt::solver_spec("COBYLA", "cobyla"));
+  setup.solvers.push_back(opt::solver_spec("SAO", "sao"));
+  const opt::ComparisonResult r = opt::run_comparison(setup);
+  ASSERT_EQ(r.runs.size(), 4u);
+  EXPECT_EQ(validated, 4);
+  auto clean = opt::benchmarks::make_benchmark("hs071");
+  for (const auto& run : r.runs) {
+    ASSERT_TRUE(run.validation.has_value());
+    EXPECT_EQ(run.validation->objective, clean->evaluate(run.result.x).objective);
+    EXPECT_EQ(run.validation_feasible, opt::is_feasible(*run.validation, 1e-2));
+    EXPECT_EQ(run.result.samples, 32 * run.result.evaluations);
+  }
+  const std::string dir = std::string(ABUOPT_BINARY_DIR) + "/benchmarking_validation_out";
+  std::filesystem::remove_all(dir);
+  opt::write_comparison(r, dir, /*make_plots=*/false);
+  std::ifstream runs(std::filesystem::path(dir) / "runs.csv");
+  std::string header, first;
+  std::getline(runs, header);
+  std::getline(runs, first);
+  EXPECT_NE(header.find(",samples,validated_objective,validated_max_violation,validated_feasible,message"),
+            std::string::npos)
+      << header;
+  EXPECT_NE(first.find("," + std::to_string(r.runs[0].result.samples) + "," +
+                       opt::format_number(r.runs[0].validation->objective) + ","),
+            std::string::npos)
+      << first;
+  std::filesystem::remove_all(dir);
+}

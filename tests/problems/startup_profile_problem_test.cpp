@@ -507,3 +507,39 @@ TEST(StartupProfileProblem, AngularAccelerationConstraintIsExact) {
                 .find("constraints.max_angular_acceleration_rad_s2"),
             std::string::npos);
 }
+
+// Adaptive sample size (docs/sao.md): with a nested design (random, halton, sobol) the value at n
+// of a problem of N runs is the n-run problem's value, bit for bit (the first n runs of one
+// sequence); n = N is evaluate(); lhs and grid designs are not nested and offer no other size.
+TEST(StartupProfileProblem, SampledValueIsTheSmallerStudy) {
+  const std::vector<double> x{35, 0.4};
+  for (const char* design : {"random", "sobol", "halton"}) {
+    const std::string extra = std::string(", seed: 5");
+    auto with = [&](int runs) {
+      std::string yaml = tiny("{kind: weighted, weights: {mean: 1, pct_mi: 0.1}}", "{max_pct_mi: 50}", extra);
+      const std::string grid = "design: grid, grid: 2";
+      yaml.replace(yaml.find(grid), grid.size(), "design: " + std::string(design) + ", runs: " + std::to_string(runs));
+      return settings_from(yaml);
+    };
+    StartupProfileProblem big(with(8));
+    StartupProfileProblem small(with(3));
+    EXPECT_EQ(big.sample_size(), 8u);
+    EXPECT_EQ(big.max_sample_size(), 8u);
+    const opt::Evaluation a = big.evaluate_sampled(x, 3);
+    const opt::Evaluation b = small.evaluate(x);
+    EXPECT_EQ(a.objective, b.objective) << design;
+    EXPECT_EQ(a.inequality, b.inequality) << design;
+    EXPECT_EQ(a.metrics.at("runs"), 3) << design;
+    EXPECT_EQ(a.metrics.at("ir_magnitude_mean"), b.metrics.at("ir_magnitude_mean")) << design;
+    const opt::Evaluation full = big.evaluate(x);
+    EXPECT_EQ(big.evaluate_sampled(x, 8).objective, full.objective) << design;
+    EXPECT_EQ(big.evaluate_sampled(x, 8, 2).objective, full.objective) << design;
+    EXPECT_THROW(big.evaluate_sampled(x, 9), std::invalid_argument);
+    EXPECT_THROW(big.evaluate_sampled(x, 0), std::invalid_argument);
+  }
+  StartupProfileProblem grid(settings_from(tiny("{kind: mean}")));
+  EXPECT_EQ(grid.sample_size(), 4u);
+  EXPECT_EQ(grid.max_sample_size(), 0u);
+  EXPECT_THROW(grid.evaluate_sampled(x, 2), std::invalid_argument);
+  EXPECT_EQ(grid.evaluate_sampled(x, 4).objective, grid.evaluate(x).objective);
+}

@@ -47,11 +47,18 @@ struct SolverSpec {
   std::string label;         // its name in tables and plots (unique)
   OptimizerOptions options;  // algorithm and settings (SAO's in options.sao); max_evaluations,
                              // constraint_tolerance and seed are set per run from the ProblemSpec
+  // A second stage (two_stage.hpp), e.g. DIRECT_L then COBYLA: `options` runs first with
+  // first_fraction of the budget (on the penalty form of weight penalty_weight when it handles
+  // bounds only and the problem has constraints), `then` from its best point with the rest.
+  std::optional<OptimizerOptions> then;
+  double first_fraction = 0.3;
+  double penalty_weight = 100.0;
 };
 // A solver with default settings; `algorithm` is checked (ConfigError listing the valid names).
 SolverSpec solver_spec(const std::string& label, const std::string& algorithm);
 // Reads one solver entry: label, algorithm (any minimize() name or sao), optional `options:`
-// (the keys of an optimizer: section except algorithm) and `sao:` sections.
+// (the keys of an optimizer: section except algorithm) and `sao:` sections, and optionally a second
+// stage: `then: {algorithm: cobyla, options: {...}}`, `first_fraction: 0.3`, `penalty_weight: 100`.
 SolverSpec read_solver_spec(YamlReader& entry);
 
 // Makes a fresh instance of a problem (called once per run).
@@ -66,6 +73,10 @@ struct ProblemSpec {
   std::uint64_t seed = 1;              // of the random starts; run k of a solver gets seed + k
   double constraint_tolerance = 1e-6;  // feasibility tolerance of every run on it
   std::optional<double> f_star;        // reference value (else best_known(), else best found)
+  // Out-of-sample check of every run's result (e.g. the startup problem on its validation set:
+  // fresh runs of a seed no optimiser saw); empty: none. Called once per run on the result's x
+  // (thread-safe: runs may go at once), never for a run without a point.
+  std::function<Evaluation(const std::vector<double>& x)> validate;
 };
 
 struct RunRecord;
@@ -101,6 +112,9 @@ struct RunRecord {
   bool feasible = false;
   long evaluations_to_solve = -1;  // t_{p,s}; -1: not solved
   std::vector<ConvergencePoint> convergence;
+  // ProblemSpec::validate of result.x (unset without one); feasible within the run's tolerance
+  std::optional<Evaluation> validation;
+  bool validation_feasible = false;
 };
 
 struct ComparisonResult {

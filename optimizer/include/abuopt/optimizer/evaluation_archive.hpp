@@ -21,8 +21,11 @@
 //   (PRAGMA quick_check on opening, or a corruption error later) is a ConfigError naming the file.
 // * Schema version: PRAGMA user_version = schema_version() (2: checksums and run counts); an
 //   archive of another version is a ConfigError that says so (it is not migrated).
-// * Run count: a value is stored with the Monte Carlo run count it was computed with (0: not a
-//   sampled problem), which is part of the key: a request at another run count never gets it.
+// * Run count: a value is stored with the Monte Carlo run count it was computed with, which is
+//   part of the key: a request at another run count never gets it. 0: the problem's own sample
+//   size (a problem that is not sampled, or a sampled one at its configured size, which its
+//   problem id fixes); n > 0: a value at another sample size n (adaptive sampling, problem.hpp
+//   evaluate_sampled: the first n samples of the problem's fixed sequence).
 //
 // * Metadata (provenance): the table `metadata` holds one row per command that opened the archive
 //   for a problem (record_metadata): time, abuopt version, git commit, command, config file and
@@ -153,6 +156,17 @@ class ArchivedProblem : public Problem {
   // are stored in input order once all are done (the archive's rows never depend on the threads).
   std::vector<BatchEvaluation> evaluate_batch(const std::vector<std::vector<double>>& xs,
                                               EvaluationScheduler& scheduler) override;
+
+  // Sample sizes (problem.hpp): forwarded; a value at n is stored under run count 0 when n is the
+  // wrapped problem's own sample_size() (so archives written before adaptive sampling still
+  // answer), else under n.
+  std::size_t sample_size() const override { return inner_.sample_size(); }
+  std::size_t max_sample_size() const override { return inner_.max_sample_size(); }
+  Evaluation evaluate_sampled(const std::vector<double>& x, std::size_t n, std::size_t concurrent = 1) override;
+  std::vector<BatchEvaluation> evaluate_batch_sampled(const std::vector<std::vector<double>>& xs, std::size_t n,
+                                                      EvaluationScheduler& scheduler) override;
+  // The archive's run count of a value at sample size n: 0 for n == sample_size(), else n.
+  long runs_key(std::size_t n) const;
 
   long hits() const { return hits_.load(); }      // answered from the archive
   long misses() const { return misses_.load(); }  // evaluated by the wrapped problem and stored

@@ -106,6 +106,9 @@ struct OptimizationResult {
   std::vector<double> x0;          // starting point
   long evaluations = 0;            // evaluations requested (including archive hits)
   long archive_hits = 0;           // of which answered from an evaluation archive
+  // Sum of the sample sizes of the evaluations (Monte Carlo runs; problem.hpp sample_size()):
+  // the simulations they stand for (archive hits included); 0 for a problem that is not sampled.
+  long samples = 0;
   long failed_evaluations = 0;     // ok == false
   long gradient_evaluations = 0;   // of which finite-difference neighbours
   long repeated_requests = 0;      // in-run repeats answered from memory (not counted above)

@@ -29,6 +29,11 @@ class PenaltyProblem : public Problem {
   Evaluation evaluate_shared(const std::vector<double>& x, std::size_t concurrent) override {
     return penalise(inner_->evaluate_shared(x, concurrent));
   }
+  std::size_t sample_size() const override { return inner_->sample_size(); }
+  std::size_t max_sample_size() const override { return inner_->max_sample_size(); }
+  Evaluation evaluate_sampled(const std::vector<double>& x, std::size_t n, std::size_t concurrent = 1) override {
+    return penalise(inner_->evaluate_sampled(x, n, concurrent));
+  }
   // The penalty form of an evaluation of the wrapped problem (what evaluate() does after calling
   // it): for values the wrapped problem computed elsewhere, e.g. on a validation sample.
   Evaluation penalise(Evaluation e) const;

@@ -92,6 +92,23 @@ class Problem {
   virtual std::vector<BatchEvaluation> evaluate_batch(const std::vector<std::vector<double>>& xs,
                                                       EvaluationScheduler& scheduler);
 
+  // ---- Sample size (a Monte Carlo estimate per evaluation; docs/sao.md "Adaptive sample size") ----
+  // The number of samples (Monte Carlo runs) evaluate(x) uses; 0: not a sampled problem (default).
+  virtual std::size_t sample_size() const { return 0; }
+  // Largest n evaluate_sampled() accepts: the length of the problem's one fixed sequence of
+  // samples; 0 (default): the sample size cannot be chosen.
+  virtual std::size_t max_sample_size() const { return 0; }
+  // evaluate(x) on the first n samples of that fixed sequence (1 <= n <= max_sample_size()), as
+  // one of `concurrent` evaluations running at once (see evaluate_shared). Common random numbers:
+  // the value at 2n shares its first n samples with the value at n, and n = sample_size() gives
+  // exactly evaluate(x). Default: n == sample_size() is evaluate_shared(x, concurrent), any other n
+  // is std::invalid_argument.
+  virtual Evaluation evaluate_sampled(const std::vector<double>& x, std::size_t n, std::size_t concurrent = 1);
+  // evaluate_batch at sample size n: the same scheduling, each point by evaluate_sampled. Default:
+  // n == sample_size() is evaluate_batch(xs, scheduler).
+  virtual std::vector<BatchEvaluation> evaluate_batch_sampled(const std::vector<std::vector<double>>& xs,
+                                                              std::size_t n, EvaluationScheduler& scheduler);
+
   // Starting point when the caller gives none; default: the middle of the bounds.
   virtual std::vector<double> initial_point() const;
 

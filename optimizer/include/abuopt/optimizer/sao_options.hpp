@@ -52,6 +52,23 @@ struct SaoGlobalPhase {
   int iterations = 0;  // >= 0; needs points > 0
 };
 
+// SAO's sample size schedule for sampled problems (docs/sao.md, "Adaptive sample size"; the
+// problem must support Problem::evaluate_sampled): iteration k evaluates at
+//   n_k = clamp(max(n_floor, n0 2^ceil(log2((r0 / r_k)^p))), n0, n_max),  never below n_{k-1},
+// r0 = initial_radius, r_k the radius; n_floor doubles (from n_k) after a failed step whose
+// shortfall is within the noise of a difference of two merits (the ratio test could not tell
+// noise from a real change). When n grows the centre is evaluated again at the new size; values at
+// smaller sizes stay in the fits, shifted by the change seen at that centre and weighted n_i / n.
+// initial 0: off (every evaluation at the problem's own sample size).
+//
+//   sao: {samples: {initial: 64, max: 256, exponent: 2}}
+struct SaoSampling {
+  int initial = 0;        // n0: 0 (off) or >= 1
+  int max = 0;            // n_max: 0, the problem's max_sample_size(); else >= initial
+  double exponent = 2.0;  // p in [0, 8]
+  bool enabled() const { return initial > 0; }
+};
+
 struct SaoOptions {
   // Surrogate of the objective and of every constraint: auto, linear, interactions,
   // pure_quadratic, quadratic, kriging. auto: the richest of quadratic > pure_quadratic > linear
@@ -147,6 +164,9 @@ struct SaoOptions {
   // Space-filling design and expected-improvement infill before the trust region (off by default).
   SaoGlobalPhase global_phase;
 
+  // Sample size that follows the need (sampled problems; off by default).
+  SaoSampling samples;
+
   // Points of this archive (same problem id) inform the surrogates without being evaluated
   // again. Not read from YAML; not owned; may be null.
   const EvaluationArchive* archive = nullptr;
@@ -160,6 +180,7 @@ struct SaoOptions {
 // value rules come from it; validate() adds the rules that relate keys.
 void describe_fields(FieldArchive& a, SaoOptions& o);
 void describe_fields(FieldArchive& a, SaoGlobalPhase& o);
+void describe_fields(FieldArchive& a, SaoSampling& o);
 
 // Reads the keys of a `sao:` section (pass root.child("sao")); absent keys keep their defaults,
 // unknown keys are errors (finish() is called), then validate().

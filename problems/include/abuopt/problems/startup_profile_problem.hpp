@@ -192,6 +192,15 @@ class StartupProfileProblem : public opt::Problem {
   // runner takes studies from several threads at once (MPI ranks: abuopt::parallel).
   bool thread_safe() const override { return !runner_ || runner_concurrent_; }
   opt::Evaluation evaluate_shared(const std::vector<double>& x, std::size_t concurrent) override;
+  // Sample size (opt::Problem, docs/sao.md "Adaptive sample size"): montecarlo.runs = N. With a
+  // nested design (random, halton, sobol: point i does not depend on the design's size, and the
+  // uncertain parameters of run i come from hash(seed, i)) the first n runs of the N are the
+  // sample at size n, so max_sample_size() = N and evaluate_sampled(x, n) is evaluate(x) on runs
+  // 0..n-1 (n = N: exactly evaluate(x)); lhs and grid designs are not nested (max 0).
+  std::size_t sample_size() const override { return settings_.study.runs; }
+  std::size_t max_sample_size() const override;
+  opt::Evaluation evaluate_sampled(const std::vector<double>& x, std::size_t n, std::size_t concurrent = 1) override;
+
   // Every Monte Carlo of this problem then runs on `runner` (e.g. MPI ranks, abuopt::parallel),
   // which must outlive the evaluations; null: a ThreadPoolRunner of montecarlo.threads each time.
   // Results do not depend on it. `concurrent_studies`: the runner's run_study may be called from
