@@ -20,7 +20,8 @@ kept; rerun the same command after an interruption):
   3. formulation 2: minimise the startup time T subject to mean |I_r| and %MI no worse than the 2003
      profile's on the same 256 starts: bisection on T, each step an optimisation at T' <= T
   4. formulation 3: robust over mu {0.02, 0.03, 0.04} and the imbalance +-20 %, from the best 19 s design
-  5. formulation 4: the k4_hold profile re-optimised per ball count (2..6 balls of equal total mass);
+  5. formulation 4: the k4_hold family and the best 19 s design's family re-optimised per ball count
+     (2..6 balls of equal total mass);
      the best 19 s design re-optimised with the PI motor and the drive's 1 Hz setpoints (f1_quantised)
   6. validation of every best design beside the 2003 profile on 1024 fresh random starts (seed 9001):
      ideal motor, at mu 0.03 and 0.04, PI motor, PI motor with 1 Hz setpoints; switch model on 256;
@@ -413,7 +414,7 @@ def main():
     counts = [] if a.skip_balls else list(range(2, 7))
     n_designs = len(FAMILIES) + 1 + len(FRONT_T) + 1 + 1 + 1 + 1
     st.evals_total = (len(FAMILIES) * (g_evals + p_evals) + p_evals + len(FRONT_T) * front_evals + 1 +
-                      f2_steps * f2_evals + robust_evals + len(counts) * p_evals + q_evals)
+                      f2_steps * f2_evals + robust_evals + 2 * len(counts) * p_evals + q_evals)
     st.runs_total = ((n_designs + 1) * val_runs * 3 + 6 * (val_runs * 2 + (switch_runs * 2 if contact == "none" else 0))
                      + len(counts) * 3 * val_runs)
     st.log(f"startup study, ball contact {contact}: {n_designs} designs, about {st.evals_total} evaluations and "
@@ -498,20 +499,26 @@ def main():
     designs["f3_robust"] = {"result": r, "formulation": 3, "T": 19}
 
     # 5. Formulation 4: the k4_hold family re-optimised per ball count at equal total ball mass (2.8e-4 kg,
-    # same material), COBYLA from formulation 1's k4_hold design, formulation 1's constraints.
+    # same material), COBYLA from formulation 1's k4_hold design, formulation 1's constraints; and the
+    # family of the best 19 s design likewise (when it is another family), from that design.
+    fam19 = best19 if best19 in FAMILIES else "f1_k3"
     k4_x = designs["f1_k4_hold"]["result"]["best"]["x"]
-    count_designs = {}
+    count_designs, count_best = {}, {}
     for nb in counts:
-        base = set_section_value(with_balls(config("f1_k4_hold"), equal_mass_balls(nb)), "runs", p_runs)
-        if a.f1_max_pct_mi != 2.0:
-            base = set_section_value(base, "max_pct_mi", f"{a.f1_max_pct_mi:g}")
-        count_designs[nb] = st.optimize(f"f4_balls{nb}", set_x0(base, k4_x), p_evals)
+        for fam, x0, store, name in (("f1_k4_hold", k4_x, count_designs, f"f4_balls{nb}"),
+                                     (fam19, designs[best19]["result"]["best"]["x"], count_best,
+                                      f"f4_balls{nb}_{fam19[3:]}")):
+            if store is count_best and fam19 == "f1_k4_hold":
+                continue
+            base = set_section_value(with_balls(config(fam), equal_mass_balls(nb)), "runs", p_runs)
+            if a.f1_max_pct_mi != 2.0:
+                base = set_section_value(base, "max_pct_mi", f"{a.f1_max_pct_mi:g}")
+            store[nb] = st.optimize(name, set_x0(base, x0), p_evals)
 
     # 5b. The best 19 s design re-optimised with the drive's 1 Hz setpoint quantisation (PI motor): a
     # design tuned with the ideal motor can lose its advantage once its dwell frequency is rounded to
     # whole Hz (section 3 of the document). Family of the best 19 s design, COBYLA from it.
     quantised = "motor:\n  kind: pi\n  quantize_setpoint_1hz: true\n"
-    fam19 = best19 if best19 in FAMILIES else "f1_k3"
     qb = set_section_value(replace_section(config(fam19), "motor", quantised), "runs", q_runs)
     if a.f1_max_pct_mi != 2.0:
         qb = set_section_value(qb, "max_pct_mi", f"{a.f1_max_pct_mi:g}")
@@ -564,20 +571,27 @@ def main():
     for nb in counts:
         bl = equal_mass_balls(nb)
         prof = count_designs[nb]["best"]["profile"]
-        for n, p in (("report_2003", profiles["report_2003"]), ("reoptimised", prof), ("f1_design", profiles[best19])):
+        runs_of = [("report_2003", profiles["report_2003"]), ("reoptimised", prof), ("f1_design", profiles[best19])]
+        if nb in count_best:
+            runs_of.append(("reoptimised_best", count_best[nb]["best"]["profile"]))
+        for n, p in runs_of:
             cfg = run_config(p, f"{n} with {nb} balls of equal total mass, ball contact {contact}", balls=bl,
                              contact=contact)
-            if n == "reoptimised":
-                with open(os.path.join(best_dir, f"balls{nb}.yaml"), "w") as f:
+            if n.startswith("reoptimised"):
+                with open(os.path.join(best_dir, f"balls{nb}{n[len('reoptimised'):]}.yaml"), "w") as f:
                     f.write(cfg)
             balls[(nb, n)] = st.montecarlo(f"balls{nb}_{n}", cfg, val_runs, VALIDATION_SEED)
-        for n in ("reoptimised", "f1_design"):
+        for n in [n for n, _ in runs_of if n != "report_2003"]:
             balls[(nb, n)]["paired"] = paired_of(os.path.join(val_dir, f"balls{nb}_{n}"),
                                                  os.path.join(val_dir, f"balls{nb}_report_2003"))
         balls[(nb, "reoptimised")]["in_sample"] = count_designs[nb]["best"]["objective"]
         balls[(nb, "reoptimised")]["feasible"] = count_designs[nb]["best"]["feasible"]
         balls[(nb, "reoptimised")]["T"] = count_designs[nb]["best"]["metrics"].get("startup_time_s")
         balls[(nb, "reoptimised")]["profile"] = prof
+        if nb in count_best:
+            b = count_best[nb]["best"]
+            balls[(nb, "reoptimised_best")].update({"in_sample": b["objective"], "feasible": b["feasible"],
+                                                    "T": b["metrics"].get("startup_time_s"), "profile": b["profile"]})
 
     write_summary(st, designs, table, balls, best19)
     st.log(f"done in {fmt_s(time.time() - st.t0)}: {os.path.join(st.out, 'summary.md')}")
@@ -638,6 +652,13 @@ def write_summary(st, designs, table, balls, best19):
             lines.append(f"| {nb} | {fmt_ir(a['ir'])} | {fmt_mi(a['ir'])} | {b['T']:.2f} | {b['in_sample']:.2f}"
                          f"{'' if b['feasible'] else ' (infeasible)'} | {fmt_ir(b['ir'])} | {fmt_mi(b['ir'])} | "
                          f"{fmt_paired(b['paired'])} | {fmt_ir(c['ir'])} | {fmt_mi(c['ir'])} | {fmt_paired(c['paired'])} |")
+        if any(k[1] == "reoptimised_best" for k in balls):
+            lines += ["", f"The family of the best 19 s design ({best19}) re-optimised per count:", "",
+                      "| balls | T [s] | in-sample | mean \\|I_r\\| | %MI | vs 2003 |", "|---|---|---|---|---|---|"]
+            for nb in counts:
+                b = balls[(nb, "reoptimised_best")]
+                lines.append(f"| {nb} | {b['T']:.2f} | {b['in_sample']:.2f}{'' if b['feasible'] else ' (infeasible)'} | "
+                             f"{fmt_ir(b['ir'])} | {fmt_mi(b['ir'])} | {fmt_paired(b['paired'])} |")
     with open(os.path.join(out, "summary.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     js = {"contact": st.a.contact, "best19": best19, "table": {n: {k: v for k, v in r.items()} for n, r in table.items()},

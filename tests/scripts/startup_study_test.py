@@ -127,7 +127,8 @@ def end_to_end(abuopt, tmp):
     check(s["contact"] == "hard", "summary.json records contact hard")
     check(len(s["table"]) == 16 and all(row["ideal"]["ok"] == 8 for row in s["table"].values()),
           f"{len(s['table'])} designs validated, every run ok")
-    check(sorted(int(k.split("_")[0]) for k in s["balls"]) == [2, 2, 2, 3, 3, 3, 4, 4, 4, 5, 5, 5, 6, 6, 6],
+    check(all(f"{nb}_{n}" in s["balls"] for nb in range(2, 7) for n in ("report_2003", "reoptimised", "f1_design"))
+          and all(int(k.split("_")[0]) in range(2, 7) for k in s["balls"]),
           "formulation 4: 2..6 balls, re-optimised, f1 design and 2003 each")
     check(len(s["f2"]["steps"]) >= 1 and s["f2"]["ref"]["runs"] == 5, "formulation 2: bisection steps recorded")
     configs = [os.path.join(d, "config.yaml") for d in
