@@ -1,12 +1,17 @@
 #!/usr/bin/env bash
 # Sanitizer and fuzz steps of CI (called by scripts/test.sh; docs/testing.md has the measured times).
-#   asan:  ASan + UBSan (-fno-sanitize-recover=all, asserts on) build of the libraries and their
-#          unit tests, runs the default suite without the command-line tests (ctest -LE long).
-#   tsan:  ThreadSanitizer build of the threaded tests only (Monte Carlo engine, optimiser
-#          evaluation archive and minimize, the startup-profile problem).
-#   fuzz:  libFuzzer targets (clang) built with ASan + UBSan, each run for ABUOPT_FUZZ_SECONDS
-#          (default 10) from the seed corpus made from configs/ (scripts/fuzz.sh).
-# Usage: scripts/sanitize.sh [asan] [tsan] [fuzz]   (no argument: all three)
+#   asan:  one clang build (build-asan/) with ASan + UBSan (-fno-sanitize-recover=all, asserts on)
+#          and libFuzzer's coverage instrumentation (-fsanitize=fuzzer-no-link): the libraries,
+#          their unit tests and the fuzz targets. Runs the unit tests (ctest -LE long).
+#   tsan:  ThreadSanitizer build (build-tsan/) of the threaded tests only (Monte Carlo engine,
+#          evaluation archive, minimize, batch evaluation, the startup-profile problem).
+#   fuzz:  the libFuzzer targets of build-asan/, each run for ABUOPT_FUZZ_SECONDS (default 10)
+#          from the seed corpus made from configs/ (scripts/fuzz.sh).
+# One instrumented build serves both the unit tests and the fuzz targets: the coverage hooks that
+# fuzzer-no-link adds are no-ops in a test program (the sanitizer runtime defines them), so a
+# second library build just for fuzzing would only cost CI time.
+# Usage: scripts/sanitize.sh [asan] [tsan] [fuzz]   (no argument: all three; fuzz builds its
+# targets in build-asan/ if the asan step did not run)
 # Every step prints "sanitize: <step> <seconds> s"; a finding fails the step (exit status != 0).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -22,29 +27,23 @@ timed() {
   echo "sanitize: $name $((SECONDS - t0)) s"
 }
 
-# The tests only: no benchmarks. -O1 keeps the build and the run fast enough for CI.
+# The tests only: no benchmarks. -O1 and line tables only (-gline-tables-only: enough for the
+# sanitizers' stack traces) keep the build and the run fast enough for CI.
 configure() {
   local dir=$1 flags=$2
-  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DABUOPT_BUILD_BENCH=OFF \
-    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g -fno-omit-frame-pointer $flags" \
+  shift 2
+  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DABUOPT_BUILD_BENCH=OFF "$@" \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only -fno-omit-frame-pointer $flags" \
     -DCMAKE_EXE_LINKER_FLAGS="$flags" >/dev/null
 }
 
-# Every unit test of the libraries (common, core, surrogate, optimizer, problems, studies). The
-# command-line tests (tests/app) are left out: they run whole studies through the binary (minutes
-# under ASan) and their input parsing is fuzzed under ASan by fuzz_cli; the MPI ones also because
-# Open MPI's own allocations at exit would read as leaks.
-asan_targets() {
-  local d
-  for d in common core surrogate optimizer problems studies; do
-    grep -h "abuopt_add_test(" "tests/$d/CMakeLists.txt" | grep -v "LABELS long" |
-      sed -E 's/^abuopt_add_test\(([a-z_0-9]+).*/\1/' | grep -v "^#"
-  done
-}
+# Every unit test of the libraries (target abuopt_library_tests: tests/common, core, surrogate,
+# optimizer, problems, studies). The command-line tests (tests/app) are left out: they run whole
+# studies through the binary (minutes under ASan) and their input parsing is fuzzed under ASan by
+# fuzz_cli; the MPI ones also because Open MPI's own allocations at exit would read as leaks.
 asan_build() {
-  configure build-asan "-fsanitize=address,undefined -fno-sanitize-recover=all"
-  # shellcheck disable=SC2046
-  cmake --build build-asan -j "$jobs" --target $(asan_targets)
+  bash scripts/fuzz.sh --build-only
+  cmake --build build-asan -j "$jobs" --target abuopt_library_tests
 }
 asan_test() {
   ASAN_OPTIONS=detect_leaks=1:strict_string_checks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
