@@ -99,6 +99,30 @@ def main():
     print(f"ball separation at the end [rad]: p10 {q(seps, 0.1):.3f}  median {q(seps, 0.5):.3f}  p90 {q(seps, 0.9):.3f}; "
           f"closer than a ball diameter (0.262): {sum(x < 0.262 for x in seps) / n * 100:.1f} %; "
           f"at least {s_goal:.3f} (needed for |I_r| <= 7e-7): {sum(x >= s_goal for x in seps) / n * 100:.1f} %")
+    # Orientation: the pair's resultant against the balancing direction (opposite the imbalance, angle pi).
+    # With separation s (b = 2 m L cos(s/2)) and orientation error delta, |I_r|^2 = a^2 + b^2 - 2 a b cos(delta),
+    # a = m_I e: |I_r| <= goal needs the separation band above AND |delta| small (at the balancing separation,
+    # b = a: |delta| <= 2 asin(goal / 2a)).
+    def orientation_error(r):
+        v = cmath.exp(1j * float(r["beta_final_1"])) + cmath.exp(1j * float(r["beta_final_2"]))
+        return abs(cmath.phase(-v))
+
+    a_ = MI * E
+    d_max = 2 * math.asin(goal / (2 * a_))
+    band = [r for r, x in zip(rows, seps) if x >= s_goal and x <= 2 * math.acos((a_ - goal) / (2 * M_BALL * L))]
+    errs = [orientation_error(r) for r in rows]
+    band_errs = [orientation_error(r) for r in band]
+    print(f"pair orientation error (resultant against the balancing direction) [deg]: median "
+          f"{math.degrees(q(errs, 0.5)):.1f}; of the {len(band) / n * 100:.1f} % of runs in the separation band "
+          f"for |I_r| <= {goal / 1e-7:.1f}: median {math.degrees(q(band_errs, 0.5)) if band else float('nan'):.1f}, "
+          f"within {math.degrees(d_max):.1f} (the balancing separation's bound): "
+          f"{sum(x <= d_max for x in band_errs) / n * 100:.1f} % of all runs")
+    # Reference: uniformly random angles (the fraction of the torus with |I_r| <= goal), 512 x 512 grid.
+    g = 512
+    hits = sum(1 for i in range(g) for j in range(g)
+               if abs(a_ + M_BALL * L * (cmath.exp(2j * math.pi * i / g) + cmath.exp(2j * math.pi * j / g))) <= goal)
+    print(f"runs with final |I_r| <= {goal / 1e-7:.1f}: {sum(u <= goal for u in ir) / n * 100:.1f} % "
+          f"(uniformly random angles: {hits / g / g * 100:.1f} % of the torus)")
     print(f"runs whose final state is in the set at f(settling): {inside / n * 100:.1f} %; "
           f"at every frequency from there to 100 Hz (0.05 Hz steps): {inside_all / n * 100:.1f} %")
 

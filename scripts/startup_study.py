@@ -1,21 +1,32 @@
 #!/usr/bin/env python3
 """The ADOPT startup-profile case study (issue 10), one command: docs/studies/startup-profile.md.
 
-    scripts/startup_study.py                      # everything, into results/startup_study/
+    scripts/startup_study.py                      # everything with hard ball contact: results/startup_study_contact/
+    scripts/startup_study.py --contact none       # the report's model (balls may overlap): results/startup_study/
     scripts/startup_study.py --out DIR --threads 2 --abuopt build/app/abuopt
     scripts/startup_study.py --scale 4            # 4x the Monte Carlo runs and evaluations
+
+--contact hard (the default) sets `abu.ball_contact: hard` in every optimised and validated config;
+--contact none leaves the configs as they are (docs/studies/startup-profile.md sections 1-6 are that
+model). The two write to different folders by default, and a folder made with one setting is refused
+with the other (OUT/contact.txt), so archives and validations of the two never mix.
 
 Stages (each resumable: an optimisation replays its evaluation archive, a finished validation is
 kept; rerun the same command after an interruption):
   1. formulation 1, per profile family (configs/studies/f1_*.yaml): global phase (DIRECT_L, L1
      penalty, 64 LHS starts, bounds only) then the local polish (COBYLA, 256 starts) from the global
      best; the 3-segment family also polished from the 2003 profile, to see what the global phase adds
-  2. formulation 5 (and 2): the front, minimum mean |I_r| at T = 4, 6, 8, 11, 15, 19 s
-  3. formulation 3: robust over mu {0.02, 0.03, 0.04} and the imbalance +-20 %, from the best 19 s design
-  4. validation of every best design beside the 2003 profile on 1024 fresh random starts (seed 9001):
-     ideal motor, at mu 0.03 and 0.04, PI motor, PI motor with 1 Hz setpoints; switch model on 256
-  5. formulation 4: the best 19 s design and the 2003 profile with 2..6 balls of equal total mass
-  6. summary.md, summary.json, best/*.yaml (ready to run), plots (profiles, front, final positions)
+  2. formulation 5: the front, minimum mean |I_r| at T = 4, 5, 6, 8, 11, 15, 19 s
+  3. formulation 2: minimise the startup time T subject to mean |I_r| and %MI no worse than the 2003
+     profile's on the same 256 starts: bisection on T, each step an optimisation at T' <= T
+  4. formulation 3: robust over mu {0.02, 0.03, 0.04} and the imbalance +-20 %, from the best 19 s design
+  5. formulation 4: the k4_hold family and the best 19 s design's family re-optimised per ball count
+     (2..6 balls of equal total mass);
+     the best 19 s design re-optimised with the PI motor and the drive's 1 Hz setpoints (f1_quantised)
+  6. validation of every best design beside the 2003 profile on 1024 fresh random starts (seed 9001):
+     ideal motor, at mu 0.03 and 0.04, PI motor, PI motor with 1 Hz setpoints; switch model on 256;
+     the ball-count designs beside the 2003 profile with the same balls
+  7. summary.md, summary.json, best/*.yaml (ready to run), plots (profiles, front, final positions)
 
 One progress line per evaluation, with the stage's and the study's ETA. Needs python3 only.
 """
@@ -218,6 +229,41 @@ def front_x0(x, bnd, T):
     return x0
 
 
+CONTACT_LINE = "  ball_contact: hard           # set by scripts/startup_study.py --contact hard\n"
+
+
+def with_contact(text, contact):
+    """The config text with hard ball contact (contact == "hard"): the commented `# ball_contact: hard`
+    line of the study configs becomes active, or the key is added at the top of `abu`. "none" returns
+    the text unchanged, so the no-contact study replays its archives and validations as before."""
+    if contact == "none":
+        return text
+    if re.search(r"^  ball_contact:", text, re.M):
+        raise ValueError("config sets abu.ball_contact itself: --contact would not decide the model")
+    new, n = re.subn(r"^  # ball_contact: hard.*\n", CONTACT_LINE, text, count=1, flags=re.M)
+    if n == 1:
+        return new
+    new, n = re.subn(r"^abu:.*\n", lambda m: m.group(0) + CONTACT_LINE, text, count=1, flags=re.M)
+    if n != 1:
+        raise ValueError("config has no abu section")
+    return new
+
+
+def equal_mass_balls(nb):
+    """nb balls of the report's material with the total mass of its two (2.8e-4 kg): d ~ m^(1/3)."""
+    m = 2.8e-4 / nb
+    return [(m, 3.0e-3 * (m / 1.4e-4) ** (1.0 / 3.0))] * nb
+
+
+def with_balls(text, balls):
+    """Adds an `abu.balls` list (the config's template has none: the report's two balls otherwise)."""
+    body = "  balls:\n" + "".join(f"    - {{mass_kg: {m:.6g}, diameter_m: {d:.6g}}}\n" for m, d in balls)
+    new, n = re.subn(r"^abu:.*\n", lambda m: m.group(0) + body, text, count=1, flags=re.M)
+    if n != 1:
+        raise ValueError("config has no abu section")
+    return new
+
+
 def global_config(text, runs, evaluations):
     t = set_section_value(text, "runs", runs)
     t = set_section_value(t, "max_angular_acceleration_rad_s2", "314.16\n  penalty_weight: 10")
@@ -239,11 +285,12 @@ def report_profile():
     return {"start_frequency_hz": 0, "segments": [{"end_frequency_hz": f, "duration_s": d} for f, d in REPORT_SEGMENTS]}
 
 
-def run_config(profile, title, balls=None, motor="  kind: ideal\n", method="event_driven", runs=1024):
-    """A ready-to-run config (abuopt simulate / abuopt montecarlo) of a profile."""
-    ball_lines = ""
+def run_config(profile, title, balls=None, motor="  kind: ideal\n", method="event_driven", runs=1024, contact="none"):
+    """A ready-to-run config (abuopt simulate / abuopt montecarlo) of a profile. contact "none" gives
+    the text of the no-contact study (its validations stay valid), "hard" adds abu.ball_contact."""
+    ball_lines = "  ball_contact: hard\n" if contact == "hard" else ""
     if balls:
-        ball_lines = "  balls:\n" + "".join(f"    - {{mass_kg: {m:.6g}, diameter_m: {d:.6g}}}\n" for m, d in balls)
+        ball_lines += "  balls:\n" + "".join(f"    - {{mass_kg: {m:.6g}, diameter_m: {d:.6g}}}\n" for m, d in balls)
     return (f"# {title}\n"
             "#   abuopt simulate THIS.yaml --beta0 0.5,3.0\n"
             "#   abuopt montecarlo THIS.yaml          # 1024 random starts, seed 9001 (the study's validation set)\n"
@@ -276,6 +323,29 @@ def statistics_of(d):
     return out
 
 
+def paired_of(d_design, d_ref):
+    """Mean over the same starts of the design's |I_r| minus the reference's [1e-7 kg m], 95 % interval.
+    Both folders must come from the same seed, runs and ball count (the same initial angles, run by run)."""
+    def by_run(d):
+        return {r["index"]: float(r["ir_magnitude_kgm"]) / 1e-7
+                for r in csv.DictReader(open(os.path.join(d, "runs.csv"))) if r["status"] == "ok"}
+    a, b = by_run(d_design), by_run(d_ref)
+    v = [a[k] - b[k] for k in a if k in b]
+    n = len(v)
+    if n < 2:
+        return None
+    mean = sum(v) / n
+    half = 1.96 * math.sqrt(sum((x - mean) ** 2 for x in v) / (n - 1)) / math.sqrt(n)
+    ref_mean = sum(b[k] for k in a if k in b) / n
+    return {"n": n, "mean": mean, "lo": mean - half, "hi": mean + half, "relative_pct": 100.0 * mean / ref_mean}
+
+
+def fmt_paired(p):
+    if not p:
+        return "-"
+    return f"{p['mean']:+.2f} [{p['lo']:+.2f}, {p['hi']:+.2f}] ({p['relative_pct']:+.1f} %)"
+
+
 def wilson(k, n, z=1.96):
     if n == 0:
         return (float("nan"), float("nan"))
@@ -296,30 +366,70 @@ def fmt_mi(s):
 
 def main():
     ap = argparse.ArgumentParser(description="ADOPT startup-profile case study (issue 10)")
-    ap.add_argument("--out", default=os.path.join("results", "startup_study"))
+    ap.add_argument("--contact", choices=["hard", "none"], default="hard",
+                    help="ball-to-ball contact model of every config (hard: the physical model, default; none: "
+                         "the report's model of sections 1-6 of the study's document)")
+    ap.add_argument("--out", default=None,
+                    help="output folder (default results/startup_study_contact, or results/startup_study with "
+                         "--contact none)")
     ap.add_argument("--abuopt", default=os.path.join(ROOT, "build", "app", "abuopt"))
     ap.add_argument("--threads", type=int, default=0, help="Monte Carlo threads (0 = all cores)")
     ap.add_argument("--nice", type=int, default=10)
     ap.add_argument("--scale", type=float, default=1.0, help="multiplies runs and evaluations (1 = about 30 min on 2 cores)")
     ap.add_argument("--val-runs", type=int, default=1024, help="fresh random starts per validation (>= 1024 for the report)")
+    ap.add_argument("--f1-max-pct-mi", type=float, default=None,
+                    help="formulation 1's bound on %%MI(|I_r|) (default 2, the goal, without contact; 4 with contact: "
+                         "half the 2003 profile's %%MI under contact, see the document's section 8)")
     ap.add_argument("--skip-balls", action="store_true", help="skip formulation 4 (ball count)")
     a = ap.parse_args()
+    if a.out is None:
+        a.out = os.path.join("results", "startup_study_contact" if a.contact == "hard" else "startup_study")
+    if a.f1_max_pct_mi is None:
+        a.f1_max_pct_mi = 4.0 if a.contact == "hard" else 2.0
+    if not 0 < a.f1_max_pct_mi <= 100:
+        sys.exit(f"--f1-max-pct-mi {a.f1_max_pct_mi}: must be in (0, 100]")
+    if a.scale <= 0:
+        sys.exit(f"--scale {a.scale}: must be > 0")
+    if a.val_runs < 2:
+        sys.exit(f"--val-runs {a.val_runs}: must be >= 2")
+    if not os.access(a.abuopt, os.X_OK):
+        sys.exit(f"--abuopt {a.abuopt}: not an executable (build it: cmake --build build --target abuopt)")
     st = Study(a)
+    marker = os.path.join(st.out, "contact.txt")
+    if os.path.exists(marker) and read(marker).strip() != a.contact:
+        sys.exit(f"{st.out} holds a study with --contact {read(marker).strip()}; refusing to mix it with "
+                 f"--contact {a.contact} (choose another --out)")
+    with open(marker, "w") as f:
+        f.write(a.contact + "\n")
+    contact = a.contact
     sc = a.scale
-    g_evals, p_evals, front_evals, robust_evals = int(120 * sc), int(60 * sc), int(40 * sc), int(30 * sc)
-    g_runs, p_runs, front_runs, robust_runs = int(64 * sc), int(256 * sc), int(128 * sc), int(96 * sc)
+    g_evals, p_evals, front_evals, robust_evals = (max(2, int(120 * sc)), max(2, int(60 * sc)),
+                                                   max(2, int(40 * sc)), max(2, int(30 * sc)))
+    g_runs, p_runs, front_runs, robust_runs = (max(4, int(64 * sc)), max(4, int(256 * sc)),
+                                               max(4, int(128 * sc)), max(4, int(96 * sc)))
+    f2_evals, f2_runs, f2_tol = max(2, int(40 * sc)), max(4, int(256 * sc)), 0.25
+    q_evals, q_runs = max(2, int(40 * sc)), max(4, int(128 * sc))  # PI + 1 Hz runs cost about 5 ideal-motor runs
+    f2_steps = math.ceil(math.log2((19.0 - 4.0) / f2_tol))
     val_runs, switch_runs = a.val_runs, min(256, a.val_runs)
-    n_designs = len(FAMILIES) + 1 + len(FRONT_T) + 1
-    st.evals_total = len(FAMILIES) * (g_evals + p_evals) + p_evals + len(FRONT_T) * front_evals + robust_evals
-    st.runs_total = (n_designs + 1) * val_runs * 3 + 4 * (val_runs * 2 + switch_runs * 2) + (0 if a.skip_balls else 10 * min(512, val_runs))
-    st.log(f"startup study: {n_designs} designs, about {st.evals_total} evaluations and {st.runs_total} validation "
-           f"runs; output {st.out}")
-    designs = {}  # name -> {"profile", "result", "formulation", "T"}
+    counts = [] if a.skip_balls else list(range(2, 7))
+    n_designs = len(FAMILIES) + 1 + len(FRONT_T) + 1 + 1 + 1 + 1
+    st.evals_total = (len(FAMILIES) * (g_evals + p_evals) + p_evals + len(FRONT_T) * front_evals + 1 +
+                      f2_steps * f2_evals + robust_evals + 2 * len(counts) * p_evals + q_evals)
+    st.runs_total = ((n_designs + 1) * val_runs * 3 + 6 * (val_runs * 2 + (switch_runs * 2 if contact == "none" else 0))
+                     + len(counts) * 3 * val_runs)
+    st.log(f"startup study, ball contact {contact}: {n_designs} designs, about {st.evals_total} evaluations and "
+           f"{st.runs_total} validation runs; output {st.out}")
+
+    def config(name):
+        return with_contact(read(os.path.join(ROOT, "configs", "studies", name + ".yaml")), contact)
+
+    designs = {}  # name -> {"result", "formulation", "T"[, "global"]}
 
     # 1. Formulation 1: global then polish, per family.
     for fam in FAMILIES:
-        base = read(os.path.join(ROOT, "configs", "studies", fam + ".yaml"))
-        base = set_section_value(base, "runs", p_runs)
+        base = set_section_value(config(fam), "runs", p_runs)
+        if a.f1_max_pct_mi != 2.0:
+            base = set_section_value(base, "max_pct_mi", f"{a.f1_max_pct_mi:g}")
         g = st.optimize(fam + "_global", global_config(base, g_runs, g_evals), g_evals)
         gx = g["best"]["x"]
         polish = st.optimize(fam + "_polish", set_x0(base, gx), p_evals)
@@ -338,8 +448,7 @@ def main():
     st.log(f"best 19 s design in sample: {best19} (objective {designs[best19]['result']['best']['objective']:.3f})")
 
     # 2. Formulation 5: the front (family k5_sweep), x0 scaled from the best 19 s sweep design.
-    front_base = read(os.path.join(ROOT, "configs", "studies", "f5_front.yaml"))
-    front_base = set_section_value(front_base, "runs", front_runs)
+    front_base = set_section_value(config("f5_front"), "runs", front_runs)
     sweep_x = designs["f1_k5_sweep"]["result"]["best"]["x"]
     bnd = bounds_of(front_base)
     for T in FRONT_T:
@@ -353,13 +462,70 @@ def main():
                                                 {"end_frequency_hz": 100.0, "duration_s": 4.0}]}}},
                         "formulation": 5, "T": 4}
 
-    # 3. Formulation 3: robust, from the best 19 s design of the sweep family.
-    rb = read(os.path.join(ROOT, "configs", "studies", "f3_robust.yaml"))
-    rb = set_section_value(rb, "runs", robust_runs)
+    # 3. Formulation 2: minimise T subject to mean |I_r| <= m03 and %MI <= p03, the 2003 profile's on the
+    # same starts. COBYLA cannot take T as objective and a Monte Carlo mean as constraint here (abuopt
+    # optimize has no such objective), so: v(T) = min mean |I_r| over profiles of duration <= T with
+    # %MI <= p03 is non-increasing in T, and the answer is the least T with v(T) <= m03: bisection on T.
+    f2_base = set_section_value(config("f5_front"), "runs", f2_runs)
+    ref = set_section_value(config("f1_k3"), "runs", f2_runs)  # x0 of the k3 family = the 2003 profile
+    r03 = st.optimize("f2_ref2003", ref, 1)["best"]
+    m03, p03 = r03["objective"], r03["metrics"]["pct_mi"]
+    st.log(f"[f2] the 2003 profile on the {f2_runs} design starts: mean |I_r| {m03:.3f}, %MI {p03:.2f}")
+    f2_base = set_section_value(f2_base, "max_pct_mi", f"{max(p03, 0.01):.6g}")
+    lo, hi, x_best, f2_best, f2_log = 4.0, 19.0, sweep_x, None, []
+    while hi - lo > f2_tol:
+        T = round((lo + hi) / 2, 4)
+        t = set_section_value(f2_base, "max_startup_time_s", T)
+        r = st.optimize(f"f2_T{T:.4f}", set_x0(t, front_x0(x_best, bnd, T)), f2_evals)
+        b = r["best"]
+        ok = bool(b["feasible"]) and b["objective"] <= m03
+        f2_log.append({"T_bound": T, "feasible": ok, "mean": b["objective"], "pct_mi": b["metrics"]["pct_mi"],
+                       "T": b["metrics"]["startup_time_s"], "constraints_feasible": bool(b["feasible"])})
+        st.log(f"[f2] T <= {T:.3f} s: best mean {b['objective']:.3f} (2003 {m03:.3f}), %MI {b['metrics']['pct_mi']:.2f} "
+               f"(2003 {p03:.2f}), T {b['metrics']['startup_time_s']:.3f} s: {'feasible' if ok else 'infeasible'}")
+        if ok:
+            hi, x_best, f2_best = T, b["x"], r
+        else:
+            lo = T
+    if f2_best is None:
+        st.log("[f2] no profile shorter than 19 s met both; formulation 2's design is the 2003 profile")
+        f2_best = {"best": {"objective": m03, "feasible": True, "x": {}, "profile": report_profile()}}
+    designs["f2_min_T"] = {"result": f2_best, "formulation": 2, "T": hi, "steps": f2_log, "ref": {"mean": m03, "pct_mi": p03,
+                                                                                                "runs": f2_runs}}
+
+    # 4. Formulation 3: robust, from the best 19 s design of the sweep family.
+    rb = set_section_value(config("f3_robust"), "runs", robust_runs)
     r = st.optimize("f3_robust", set_x0(rb, sweep_x), robust_evals)
     designs["f3_robust"] = {"result": r, "formulation": 3, "T": 19}
 
-    # 4. Validation on fresh starts, beside the 2003 profile on the same starts.
+    # 5. Formulation 4: the k4_hold family re-optimised per ball count at equal total ball mass (2.8e-4 kg,
+    # same material), COBYLA from formulation 1's k4_hold design, formulation 1's constraints; and the
+    # family of the best 19 s design likewise (when it is another family), from that design.
+    fam19 = best19 if best19 in FAMILIES else "f1_k3"
+    k4_x = designs["f1_k4_hold"]["result"]["best"]["x"]
+    count_designs, count_best = {}, {}
+    for nb in counts:
+        for fam, x0, store, name in (("f1_k4_hold", k4_x, count_designs, f"f4_balls{nb}"),
+                                     (fam19, designs[best19]["result"]["best"]["x"], count_best,
+                                      f"f4_balls{nb}_{fam19[3:]}")):
+            if store is count_best and fam19 == "f1_k4_hold":
+                continue
+            base = set_section_value(with_balls(config(fam), equal_mass_balls(nb)), "runs", p_runs)
+            if a.f1_max_pct_mi != 2.0:
+                base = set_section_value(base, "max_pct_mi", f"{a.f1_max_pct_mi:g}")
+            store[nb] = st.optimize(name, set_x0(base, x0), p_evals)
+
+    # 5b. The best 19 s design re-optimised with the drive's 1 Hz setpoint quantisation (PI motor): a
+    # design tuned with the ideal motor can lose its advantage once its dwell frequency is rounded to
+    # whole Hz (section 3 of the document). Family of the best 19 s design, COBYLA from it.
+    quantised = "motor:\n  kind: pi\n  quantize_setpoint_1hz: true\n"
+    qb = set_section_value(replace_section(config(fam19), "motor", quantised), "runs", q_runs)
+    if a.f1_max_pct_mi != 2.0:
+        qb = set_section_value(qb, "max_pct_mi", f"{a.f1_max_pct_mi:g}")
+    r = st.optimize("f1_quantised", set_x0(qb, designs[best19]["result"]["best"]["x"]), q_evals)
+    designs["f1_quantised"] = {"result": r, "formulation": "1q", "T": 19}
+
+    # 6. Validation on fresh starts, beside the 2003 profile on the same starts.
     profiles = {"report_2003": report_profile()}
     for n, d in designs.items():
         profiles[n] = d["result"]["best"]["profile"]
@@ -367,59 +533,90 @@ def main():
     os.makedirs(best_dir, exist_ok=True)
     table = {}
     # The motor and switch-model checks (the expensive ones) for the designs the document reports in full.
-    heavy = {"report_2003", best19, "f3_robust", "f5_T8"}
+    heavy = {"report_2003", best19, "f3_robust", "f5_T8", "f2_min_T", "f1_quantised"}
+    val_dir = os.path.join(st.out, "validation")
     for n, prof in profiles.items():
         title = f"startup study design {n}" if n != "report_2003" else "the 2003 report's final profile"
-        cfg = run_config(prof, title)
+        title += f", ball contact {contact}"
+        cfg = run_config(prof, title, contact=contact)
         with open(os.path.join(best_dir, n + ".yaml"), "w") as f:
             f.write(cfg)
         row = {"T": sum(d for _, d in segments_of(prof)), "profile": prof}
         row["ideal"] = st.montecarlo(n, cfg, val_runs, VALIDATION_SEED)
         row["mu0.03"] = st.montecarlo(n + "_mu0.03", cfg, val_runs, VALIDATION_SEED, ["--mu", "0.03"])
         row["mu0.04"] = st.montecarlo(n + "_mu0.04", cfg, val_runs, VALIDATION_SEED, ["--mu", "0.04"])
+        for key, sub in (("paired", ""), ("paired_mu0.03", "_mu0.03"), ("paired_mu0.04", "_mu0.04")):
+            row[key] = None if n == "report_2003" else paired_of(os.path.join(val_dir, n + sub),
+                                                                 os.path.join(val_dir, "report_2003" + sub))
         table[n] = row
         if n not in heavy:
             continue
-        row["pi"] = st.montecarlo(n + "_pi", run_config(prof, title, motor="  kind: pi\n"), val_runs, VALIDATION_SEED)
+        row["pi"] = st.montecarlo(n + "_pi", run_config(prof, title, motor="  kind: pi\n", contact=contact), val_runs,
+                                  VALIDATION_SEED)
         row["pi_1hz"] = st.montecarlo(n + "_pi_1hz",
-                                      run_config(prof, title, motor="  kind: pi\n  quantize_setpoint_1hz: true\n"),
+                                      run_config(prof, title, motor="  kind: pi\n  quantize_setpoint_1hz: true\n",
+                                                 contact=contact),
                                       val_runs, VALIDATION_SEED)
-        row["switch"] = st.montecarlo(n + "_switch", run_config(prof, title, method="switch_model"), switch_runs,
-                                      VALIDATION_SEED)
-        row["ideal256"] = st.montecarlo(n + "_ideal256", cfg, switch_runs, VALIDATION_SEED)
+        if contact == "none":  # the switch model has no contact events: the check needs the report's model
+            row["switch"] = st.montecarlo(n + "_switch", run_config(prof, title, method="switch_model"), switch_runs,
+                                          VALIDATION_SEED)
+            row["ideal256"] = st.montecarlo(n + "_ideal256", cfg, switch_runs, VALIDATION_SEED)
     shutil.copyfile(os.path.join(best_dir, best19 + ".yaml"), os.path.join(best_dir, "best_19s.yaml"))
+    with open(os.path.join(best_dir, "f1_quantised.yaml"), "w") as f:  # ready to run with the motor it was made for
+        f.write(run_config(profiles["f1_quantised"], "startup study design f1_quantised (PI motor, 1 Hz setpoints), "
+                           f"ball contact {contact}", motor=quantised[len("motor:\n"):], contact=contact))
 
-    # 5. Formulation 4: ball count at equal total ball mass (2.8e-4 kg), same material (d ~ m^(1/3)).
+    # Formulation 4's designs and the 2003 profile with the same balls, on the same fresh starts.
     balls = {}
-    if not a.skip_balls:
-        for nb in range(2, 7):
-            m = 2.8e-4 / nb
-            dia = 3.0e-3 * (1.4e-4 / m) ** (-1.0 / 3.0)
-            bl = [(m, dia)] * nb
-            for n in ("report_2003", best19):
-                cfg = run_config(profiles[n], f"{n} with {nb} balls", balls=bl)
-                balls[(nb, n)] = st.montecarlo(f"balls{nb}_{n}", cfg, min(512, val_runs), VALIDATION_SEED)
+    for nb in counts:
+        bl = equal_mass_balls(nb)
+        prof = count_designs[nb]["best"]["profile"]
+        runs_of = [("report_2003", profiles["report_2003"]), ("reoptimised", prof), ("f1_design", profiles[best19])]
+        if nb in count_best:
+            runs_of.append(("reoptimised_best", count_best[nb]["best"]["profile"]))
+        for n, p in runs_of:
+            cfg = run_config(p, f"{n} with {nb} balls of equal total mass, ball contact {contact}", balls=bl,
+                             contact=contact)
+            if n.startswith("reoptimised"):
+                with open(os.path.join(best_dir, f"balls{nb}{n[len('reoptimised'):]}.yaml"), "w") as f:
+                    f.write(cfg)
+            balls[(nb, n)] = st.montecarlo(f"balls{nb}_{n}", cfg, val_runs, VALIDATION_SEED)
+        for n in [n for n, _ in runs_of if n != "report_2003"]:
+            balls[(nb, n)]["paired"] = paired_of(os.path.join(val_dir, f"balls{nb}_{n}"),
+                                                 os.path.join(val_dir, f"balls{nb}_report_2003"))
+        balls[(nb, "reoptimised")]["in_sample"] = count_designs[nb]["best"]["objective"]
+        balls[(nb, "reoptimised")]["feasible"] = count_designs[nb]["best"]["feasible"]
+        balls[(nb, "reoptimised")]["T"] = count_designs[nb]["best"]["metrics"].get("startup_time_s")
+        balls[(nb, "reoptimised")]["profile"] = prof
+        if nb in count_best:
+            b = count_best[nb]["best"]
+            balls[(nb, "reoptimised_best")].update({"in_sample": b["objective"], "feasible": b["feasible"],
+                                                    "T": b["metrics"].get("startup_time_s"), "profile": b["profile"]})
 
     write_summary(st, designs, table, balls, best19)
     st.log(f"done in {fmt_s(time.time() - st.t0)}: {os.path.join(st.out, 'summary.md')}")
 
-
 def write_summary(st, designs, table, balls, best19):
     out = st.out
-    lines = ["# Startup-profile study: validation (1024 fresh random starts, seed 9001; I_r in 1e-7 kg m, 95 % intervals)",
-             "", "| design | T [s] | in-sample mean | mean \\|I_r\\| | %MI \\|I_r\\| | mean I_r,x | %MI I_r,x | "
-             "mu 0.03 mean | mu 0.04 mean | PI mean | PI 1 Hz mean (ok runs) | switch 256 mean | event 256 mean | max amp [mm] |",
-             "|" + "---|" * 14]
+    n_val = table["report_2003"]["ideal"]["runs"]
+    lines = [f"# Startup-profile study, ball contact {st.a.contact}: validation ({n_val} fresh random starts, seed "
+             f"{VALIDATION_SEED}; I_r in 1e-7 kg m, 95 % intervals)", "",
+             "\"vs 2003\": the mean over the same starts of the design's |I_r| minus the 2003 profile's (paired).", "",
+             "| design | T [s] | in-sample mean | mean \\|I_r\\| | %MI \\|I_r\\| | mean I_r,x | %MI I_r,x | vs 2003 | "
+             "mu 0.03 mean | %MI mu 0.03 | vs 2003 mu 0.03 | mu 0.04 mean | PI mean | PI 1 Hz mean (ok runs) | "
+             "switch 256 mean | event 256 mean | max amp [mm] |",
+             "|" + "---|" * 17]
     for n, r in table.items():
         ins = designs[n]["result"]["best"]["objective"] if n in designs else float("nan")
         i = r["ideal"]
         heavy = ("| - | - | - | - " if "pi" not in r else
                  f"| {fmt_ir(r['pi']['ir'])} | {fmt_ir(r['pi_1hz']['ir'])} ({r['pi_1hz']['ok']}) | "
-                 f"{fmt_ir(r['switch']['ir'])} | {fmt_ir(r['ideal256']['ir'])} ")
+                 + (f"{fmt_ir(r['switch']['ir'])} | {fmt_ir(r['ideal256']['ir'])} " if "switch" in r else
+                    "(no contact events) | - "))
         lines.append(
             f"| {n} | {r['T']:.2f} | {ins:.2f} | {fmt_ir(i['ir'])} | {fmt_mi(i['ir'])} | {fmt_ir(i['irx'])} | "
-            f"{fmt_mi(i['irx'])} | {fmt_ir(r['mu0.03']['ir'])} | {fmt_ir(r['mu0.04']['ir'])} " + heavy +
-            f"| {i['amp_max_mm']:.3f} |")
+            f"{fmt_mi(i['irx'])} | {fmt_paired(r['paired'])} | {fmt_ir(r['mu0.03']['ir'])} | {fmt_mi(r['mu0.03']['ir'])} | "
+            f"{fmt_paired(r['paired_mu0.03'])} | {fmt_ir(r['mu0.04']['ir'])} " + heavy + f"| {i['amp_max_mm']:.3f} |")
     lines += ["", f"best 19 s design (in sample): {best19}", ""]
     lines += ["## Profiles", ""]
     for n, r in table.items():
@@ -429,20 +626,43 @@ def write_summary(st, designs, table, balls, best19):
     for n, d in designs.items():
         if "global" in d:
             g = d["global"]["best"]
-            lines.append(f"- {n}: global best in sample {g['objective']:.3f} (64 starts, penalised; feasible "
-                         f"{g['feasible']}), polished {d['result']['best']['objective']:.3f} (256 starts), x = "
-                         + ", ".join(f"{k}={v:.4g}" for k, v in sorted(d['result']['best']['x'].items())))
+            lines.append(f"- {n}: global best in sample {g['objective']:.3f} (penalised; feasible {g['feasible']}), "
+                         f"polished {d['result']['best']['objective']:.3f} (feasible {d['result']['best']['feasible']}), "
+                         "x = " + ", ".join(f"{k}={v:.4g}" for k, v in sorted(d['result']['best']['x'].items())))
     if "f1_k3_local2003" in designs:
-        lines.append(f"- f1_k3 polished from the 2003 profile: {designs['f1_k3_local2003']['result']['best']['objective']:.3f}")
+        b = designs['f1_k3_local2003']['result']['best']
+        lines.append(f"- f1_k3 polished from the 2003 profile: {b['objective']:.3f} (feasible {b['feasible']})")
+    f2 = designs.get("f2_min_T")
+    if f2:
+        ref = f2["ref"]
+        lines += ["", f"## Formulation 2: least T with mean |I_r| <= {ref['mean']:.3f} and %MI <= {ref['pct_mi']:.2f} "
+                  f"(the 2003 profile on the same {ref['runs']} starts)", "",
+                  "| T bound [s] | best mean \\|I_r\\| | %MI | T [s] | other constraints met | verdict |", "|---|---|---|---|---|---|"]
+        for s in f2["steps"]:
+            lines.append(f"| {s['T_bound']:.4f} | {s['mean']:.3f} | {s['pct_mi']:.2f} | {s['T']:.3f} | "
+                         f"{s['constraints_feasible']} | {'feasible' if s['feasible'] else 'infeasible'} |")
     if balls:
-        lines += ["", "## Ball count (equal total ball mass 2.8e-4 kg; 512 fresh starts)", "",
-                  "| balls | 2003 mean \\|I_r\\| | 2003 %MI | best_19s mean \\|I_r\\| | best_19s %MI |", "|---|---|---|---|---|"]
-        for nb in range(2, 7):
-            a, b = balls[(nb, "report_2003")], balls[(nb, best19)]
-            lines.append(f"| {nb} | {fmt_ir(a['ir'])} | {fmt_mi(a['ir'])} | {fmt_ir(b['ir'])} | {fmt_mi(b['ir'])} |")
+        counts = sorted({k[0] for k in balls})
+        lines += ["", f"## Ball count (equal total ball mass 2.8e-4 kg; {n_val} fresh starts per row, the 2003 profile "
+                  "with the same balls on the same starts)", "",
+                  "| balls | 2003 mean \\|I_r\\| | 2003 %MI | re-optimised T [s] | in-sample | mean \\|I_r\\| | %MI | vs 2003 | "
+                  "f1 design mean | f1 design %MI | f1 design vs 2003 |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+        for nb in counts:
+            a, b, c = balls[(nb, "report_2003")], balls[(nb, "reoptimised")], balls[(nb, "f1_design")]
+            lines.append(f"| {nb} | {fmt_ir(a['ir'])} | {fmt_mi(a['ir'])} | {b['T']:.2f} | {b['in_sample']:.2f}"
+                         f"{'' if b['feasible'] else ' (infeasible)'} | {fmt_ir(b['ir'])} | {fmt_mi(b['ir'])} | "
+                         f"{fmt_paired(b['paired'])} | {fmt_ir(c['ir'])} | {fmt_mi(c['ir'])} | {fmt_paired(c['paired'])} |")
+        if any(k[1] == "reoptimised_best" for k in balls):
+            lines += ["", f"The family of the best 19 s design ({best19}) re-optimised per count:", "",
+                      "| balls | T [s] | in-sample | mean \\|I_r\\| | %MI | vs 2003 |", "|---|---|---|---|---|---|"]
+            for nb in counts:
+                b = balls[(nb, "reoptimised_best")]
+                lines.append(f"| {nb} | {b['T']:.2f} | {b['in_sample']:.2f}{'' if b['feasible'] else ' (infeasible)'} | "
+                             f"{fmt_ir(b['ir'])} | {fmt_mi(b['ir'])} | {fmt_paired(b['paired'])} |")
     with open(os.path.join(out, "summary.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
-    js = {"best19": best19, "table": {n: {k: v for k, v in r.items()} for n, r in table.items()},
+    js = {"contact": st.a.contact, "best19": best19, "table": {n: {k: v for k, v in r.items()} for n, r in table.items()},
+          "f2": {k: v for k, v in (f2 or {}).items() if k in ("steps", "ref", "T")},
           "balls": {f"{k[0]}_{k[1]}": v for k, v in balls.items()}}
     with open(os.path.join(out, "summary.json"), "w") as f:
         json.dump(js, f, indent=1)
@@ -471,7 +691,10 @@ def final_positions_plot(st, table, names, gp):
         fs = sorted(settle_frequency(table[n]["profile"], float(r["settling_time_s"])) for r in rows)
         f_med = fs[len(fs) // 2]
         eq = os.path.join(out, "eqset_" + n)
-        subprocess.run([st.a.abuopt, "eqset", os.path.join(ROOT, "configs", "eqset.yaml"), "--freq", f"{f_med:.3f}",
+        eq_cfg = os.path.join(out, "eqset.yaml")  # configs/eqset.yaml with the study's contact setting
+        with open(eq_cfg, "w") as f:
+            f.write(with_contact(read(os.path.join(ROOT, "configs", "eqset.yaml")), st.a.contact))
+        subprocess.run([st.a.abuopt, "eqset", eq_cfg, "--freq", f"{f_med:.3f}",
                         "--grid", "128", "--out", eq], capture_output=True, text=True)
         with open(os.path.join(out, f"final_{n}.dat"), "w") as f:
             for r in rows:
@@ -479,8 +702,8 @@ def final_positions_plot(st, table, names, gp):
                 b2 = float(r["beta_final_2"]) % (2 * math.pi)
                 f.write(f"{b1:.5f},{b2:.5f},{float(r['ir_magnitude_kgm']) / 1e-7:.4f}\n")
         below = sum(1 for r in rows if float(r["ir_magnitude_kgm"]) / 1e-7 < r_lock) / len(rows) * 100
-        body = (f"set title '{n}: final angles of {len(rows)} fresh starts over the set at {f_med:.2f} Hz\\n"
-                f"(the median settling speed); {below:.0f} % below r_lock = 15.9e-7'\n"
+        body = (f"set title \"{n}, contact {st.a.contact}: final angles of {len(rows)} fresh starts\\nover the set "
+                f"at {f_med:.2f} Hz (the median settling speed); {below:.0f} % below r_lock = 15.9e-7\"\n"
                 "set xlabel 'beta_1 [rad]'; set ylabel 'beta_2 [rad]'; set size square; set xrange [0:6.2832]; "
                 "set yrange [0:6.2832]\nset datafile separator ','\nset cblabel 'final |I_r| [1e-7 kg m]'\n"
                 "set palette defined (0 'blue', 15.9 'green', 20.7 'orange', 35 'red'); set cbrange [0:35]\n"
@@ -499,7 +722,7 @@ def final_positions_plot(st, table, names, gp):
 def make_plots(st, table, designs, best19):
     out = st.out
     gp = shutil.which("gnuplot")
-    final_positions_plot(st, table, ["report_2003", best19], gp)
+    final_positions_plot(st, table, ["report_2003", best19, "f2_min_T"], gp)
     # Profiles f(t), sampled.
     with open(os.path.join(out, "profiles.dat"), "w") as f:
         for n, r in table.items():
@@ -512,25 +735,28 @@ def make_plots(st, table, designs, best19):
                 t0, f0 = t0 + dt, fe
             f.write("\n\n")
     names = list(table)
+    n_val = table["report_2003"]["ideal"]["runs"]
     with open(os.path.join(out, "front.dat"), "w") as f:
         for n, r in table.items():
             i = r["ideal"]["ir"]
             f.write(f"{r['T']:.3f} {i['mean']:.4f} {i['lo']:.4f} {i['hi']:.4f} {i['pct_mi']:.3f} \"{n}\"\n")
     scripts = {
-        "profiles.png": "set title 'startup profiles: the study designs against the 2003 profile'\n"
+        "profiles.png": f"set title 'startup profiles: the study designs (ball contact {st.a.contact}) against the 2003 profile'\n"
                         "set xlabel 'time [s]'; set ylabel 'frequency [Hz]'; set yrange [20:35]; set key outside right\n"
                         "plot " + ", ".join(f"'profiles.dat' index {k} with lines lw {3 if n == 'report_2003' else 1.5} "
                                            f"title '{n}'" for k, n in enumerate(names)),
         "profiles_full.png": "set title 'startup profiles (0 to 100 Hz)'\nset xlabel 'time [s]'; set ylabel 'frequency [Hz]'; set key outside right\n"
                              "plot " + ", ".join(f"'profiles.dat' index {k} with lines title '{n}'" for k, n in enumerate(names)),
-        "front.png": "set title 'startup time against mean |I_r| (1024 fresh starts, 95 % intervals)'\n"
+        "front.png": f"set title 'startup time against mean |I_r| ({n_val} fresh starts, 95 % intervals), ball contact {st.a.contact}'\n"
                      "set xlabel 'startup time [s]'; set ylabel 'mean |I_r| [1e-7 kg m]'; set y2label '%MI(|I_r|) [%]'\n"
-                     "set ytics nomirror; set y2tics; set key top right; set xrange [3:20]; set yrange [0:40]\n"
+                     "set ytics nomirror; set y2tics; set key top right; set xrange [3:20]; set yrange [0:40]; set y2range [0:*]\n"
                      "plot 'front.dat' using 1:2:3:4 with yerrorbars pt 7 title 'mean |I_r|', "
                      "'front.dat' using 1:5 axes x1y2 with points pt 6 ps 1.5 title '%MI (right axis)', "
-                     "'front.dat' using 1:($1 < 16 || strcol(6) eq 'report_2003' || strcol(6) eq 'f1_k4_hold' ? $2 : 1/0):6 "
-                     "with labels offset 0,1.2 font ',8' notitle, 7.0 with lines dt 2 title 'goal 7.0', "
-                     "11.48 with lines dt 3 title 'pair floor 11.48 (balls together)'",
+                     "'front.dat' using 1:($1 < 16 || strcol(6) eq 'report_2003' || strcol(6) eq 'f1_k4_hold' || strcol(6) eq 'f2_min_T' ? $2 : 1/0):6 "
+                     "with labels offset 0,1.2 font ',8' notitle, 7.0 with lines dt 2 lw 1.5 title 'goal 7.0', "
+                     + ("11.48 with lines dt 3 lw 1.5 lc rgb 'black' title 'pair floor 11.48 (balls together)'"
+                        if st.a.contact == "none" else
+                        "11.20 with lines dt 3 lw 1.5 lc rgb 'black' title 'pair floor 11.20 (balls touching)'"),
     }
     for png, body in scripts.items():
         p = os.path.join(out, png.replace(".png", ".gp"))

@@ -1,0 +1,160 @@
+#!/usr/bin/env python3
+"""Tests of scripts/startup_study.py (the issue-10 study runner).
+
+    startup_study_test.py ABUOPT unit          # default suite, a few seconds: the --contact plumbing
+    startup_study_test.py ABUOPT end_to_end    # ctest -L long: the whole study at --scale 0.02, then resumed
+
+unit: every study config gets exactly one active `ball_contact: hard` with --contact hard and is left
+byte-identical with --contact none (so the no-contact study replays its archives); abuopt accepts
+the generated configs; the equal-mass ball sets have the closed-form masses and diameters; the paired
+difference is the mean of the run-by-run differences; an output folder of one contact setting is
+refused with the other.
+end_to_end: every stage runs and writes its outputs, every optimised and validated config carries the
+contact setting, and a second run replays every evaluation from the archives (nothing computed).
+"""
+import csv
+import importlib.util
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+SCRIPT = os.path.join(ROOT, "scripts", "startup_study.py")
+spec = importlib.util.spec_from_file_location("startup_study", SCRIPT)
+study = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(study)
+
+failures = []
+
+
+def check(cond, what):
+    print(("ok   " if cond else "FAIL ") + what)
+    if not cond:
+        failures.append(what)
+
+
+def active_contact_lines(text):
+    return re.findall(r"^\s*ball_contact:\s*(\S+)", text, re.M)
+
+
+def unit(abuopt, tmp):
+    cdir = os.path.join(ROOT, "configs", "studies")
+    for name in sorted(os.listdir(cdir)):
+        if not name.endswith(".yaml"):
+            continue
+        text = study.read(os.path.join(cdir, name))
+        check(study.with_contact(text, "none") == text, f"{name}: --contact none leaves the config unchanged")
+        hard = study.with_contact(text, "hard")
+        check(active_contact_lines(hard) == ["hard"], f"{name}: --contact hard sets exactly one ball_contact: hard")
+        check(active_contact_lines(text) == [], f"{name}: the committed config decides no contact model itself")
+    try:
+        study.with_contact("abu:\n  ball_contact: none\n", "hard")
+        check(False, "a config that sets ball_contact itself is refused")
+    except ValueError:
+        check(True, "a config that sets ball_contact itself is refused")
+    check(study.with_contact("abu:\n  friction_mu: 0.02\n", "hard") == "abu:\n" + study.CONTACT_LINE + "  friction_mu: 0.02\n",
+          "ball_contact is added to an abu section without the commented line")
+
+    # Equal total mass 2.8e-4 kg, same material: d = 3 mm (2 / nb)^(1/3).
+    for nb in range(2, 7):
+        balls = study.equal_mass_balls(nb)
+        mass = sum(m for m, _ in balls)
+        d = balls[0][1]
+        check(len(balls) == nb and abs(mass - 2.8e-4) < 1e-15 and abs(d - 3e-3 * (2.0 / nb) ** (1 / 3)) < 1e-15,
+              f"{nb} balls: total mass {mass:.4g} kg, diameter {d * 1e3:.5f} mm")
+
+    # The generated run configs parse and run with either contact setting (4 runs each).
+    k4 = study.with_balls(study.with_contact(study.read(os.path.join(cdir, "f1_k4_hold.yaml")), "hard"),
+                          study.equal_mass_balls(3))
+    cfg = os.path.join(tmp, "k4_3balls.yaml")
+    with open(cfg, "w") as f:
+        f.write(study.set_section_value(k4, "runs", 4))
+    r = subprocess.run([abuopt, "optimize", cfg, "--out", os.path.join(tmp, "k4"), "--max-evaluations", "1",
+                        "--threads", "1"], capture_output=True, text=True)
+    res = json.load(open(os.path.join(tmp, "k4", "result.json"))) if r.returncode in (0, 3) else {}
+    check(r.returncode in (0, 3) and res.get("best", {}).get("metrics", {}).get("runs") == 4,
+          "abuopt optimize accepts a study config with 3 balls and hard contact")
+    for contact in ("none", "hard"):
+        text = study.run_config(study.report_profile(), "test", contact=contact, balls=study.equal_mass_balls(4))
+        check(active_contact_lines(text) == ([] if contact == "none" else ["hard"]),
+              f"run_config --contact {contact}: ball_contact lines")
+        cfg = os.path.join(tmp, f"run_{contact}.yaml")
+        with open(cfg, "w") as f:
+            f.write(text)
+        out = os.path.join(tmp, f"mc_{contact}")
+        r = subprocess.run([abuopt, "montecarlo", cfg, "--runs", "4", "--threads", "1", "--out", out],
+                           capture_output=True, text=True)
+        ok = r.returncode == 0 and json.load(open(os.path.join(out, "summary.json")))["ok"] == 4
+        check(ok, f"abuopt montecarlo runs the validation config with contact {contact} (4 balls)")
+
+    # Paired difference: the mean of the run-by-run differences, over the runs ok in both.
+    a, b = os.path.join(tmp, "pa"), os.path.join(tmp, "pb")
+    for d, vals in ((a, [3.0, 5.0, 7.0, None]), (b, [1.0, 2.0, 3.0, 9.0])):
+        os.makedirs(d, exist_ok=True)
+        with open(os.path.join(d, "runs.csv"), "w") as f:
+            w = csv.writer(f)
+            w.writerow(["index", "ir_magnitude_kgm", "status"])
+            for i, v in enumerate(vals):
+                w.writerow([i, (v if v is not None else 0.0) * 1e-7, "ok" if v is not None else "solver_failure"])
+    p = study.paired_of(a, b)
+    # differences 2, 3, 4: mean 3, sd 1, half width 1.96 / sqrt(3); reference mean 2 -> +150 %
+    check(p["n"] == 3 and abs(p["mean"] - 3.0) < 1e-12 and abs(p["hi"] - 3.0 - 1.96 / 3 ** 0.5) < 1e-12
+          and abs(p["relative_pct"] - 150.0) < 1e-9, f"paired difference {p}")
+
+    # A folder made with one contact setting is refused with the other, before any work.
+    out = os.path.join(tmp, "mixed")
+    os.makedirs(out)
+    with open(os.path.join(out, "contact.txt"), "w") as f:
+        f.write("none\n")
+    r = subprocess.run([sys.executable, SCRIPT, "--abuopt", abuopt, "--out", out, "--contact", "hard"],
+                       capture_output=True, text=True)
+    check(r.returncode != 0 and "refusing" in r.stderr and os.listdir(out) == ["contact.txt"],
+          "a --contact none folder is refused by --contact hard, nothing written")
+
+
+def end_to_end(abuopt, tmp):
+    out = os.path.join(tmp, "study")
+    cmd = [sys.executable, SCRIPT, "--abuopt", abuopt, "--out", out, "--scale", "0.02", "--val-runs", "8",
+           "--threads", "2", "--nice", "0"]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    check(r.returncode == 0, f"the study runs end to end (status {r.returncode}) {r.stderr[-2000:]}")
+    if r.returncode != 0:
+        return
+    s = json.load(open(os.path.join(out, "summary.json")))
+    check(s["contact"] == "hard", "summary.json records contact hard")
+    check(len(s["table"]) == 16 and all(row["ideal"]["ok"] == 8 for row in s["table"].values()),
+          f"{len(s['table'])} designs validated, every run ok")
+    check(all(f"{nb}_{n}" in s["balls"] for nb in range(2, 7) for n in ("report_2003", "reoptimised", "f1_design"))
+          and all(int(k.split("_")[0]) in range(2, 7) for k in s["balls"]),
+          "formulation 4: 2..6 balls, re-optimised, f1 design and 2003 each")
+    check(len(s["f2"]["steps"]) >= 1 and s["f2"]["ref"]["runs"] == 5, "formulation 2: bisection steps recorded")
+    configs = [os.path.join(d, "config.yaml") for d in
+               [os.path.join(out, x) for x in os.listdir(out)] + [os.path.join(out, "validation", x) for x in
+                                                                   os.listdir(os.path.join(out, "validation"))]
+               if os.path.exists(os.path.join(d, "config.yaml"))]
+    bad = [c for c in configs if active_contact_lines(study.read(c)) != ["hard"]]
+    check(len(configs) > 60 and not bad, f"all {len(configs)} configs run carry ball_contact: hard {bad[:3]}")
+    check(active_contact_lines(study.read(os.path.join(out, "best", "best_19s.yaml"))) == ["hard"],
+          "best/best_19s.yaml is ready to run with contact")
+    for png in ("front.png", "profiles.png", "profiles_full.png"):
+        check(os.path.getsize(os.path.join(out, png)) > 1000 if os.path.exists(os.path.join(out, png)) else False,
+              f"{png} drawn")
+    r2 = subprocess.run(cmd, capture_output=True, text=True)
+    computed = [l for l in r2.stdout.splitlines() if "(computed)" in l or l.startswith("[validation]")]
+    check(r2.returncode == 0 and not computed and "(archive)" in r2.stdout,
+          f"the rerun replays every evaluation and keeps every validation ({len(computed)} recomputed)")
+
+
+def main():
+    abuopt, mode = sys.argv[1], sys.argv[2]
+    with tempfile.TemporaryDirectory() as tmp:
+        {"unit": unit, "end_to_end": end_to_end}[mode](abuopt, tmp)
+    if failures:
+        sys.exit(f"{len(failures)} check(s) failed")
+
+
+if __name__ == "__main__":
+    main()
