@@ -5,9 +5,13 @@
 #include <cerrno>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <set>
 #include <cstdlib>
 #include <sstream>
+
+#include <yaml-cpp/eventhandler.h>
+#include <yaml-cpp/parser.h>
 
 namespace abuopt {
 
@@ -89,11 +93,32 @@ void check_unique_keys(const YAML::Node& n, const std::string& path, const std::
 }
 
 // One document per config: a second one (after a `---` line) would be ignored.
-YAML::Node single_document(const std::vector<YAML::Node>& docs, const std::string& what) {
-  if (docs.size() > 1)
-    throw ConfigError(what + " holds " + std::to_string(docs.size()) +
-                      " YAML documents (a line '---' starts a new one): a config is one document");
-  return docs.empty() ? YAML::Node() : docs.front();
+// Parse events are not needed to count documents: this handler ignores them.
+class IgnoreEvents final : public YAML::EventHandler {
+ public:
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t, const std::string&) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnMapEnd() override {}
+};
+
+// The first YAML document of `text`; a second one is an error. yaml-cpp's LoadAll is not used: on
+// some malformed input (found by fuzz_config) its parser keeps reporting empty documents, and
+// LoadAll collects them until memory runs out. Asking the parser for two documents at most cannot
+// loop. (A config is small: parsing it twice costs nothing that matters.)
+YAML::Node single_document(const std::string& text, const std::string& what) {
+  std::istringstream count_in(text);
+  YAML::Parser parser(count_in);
+  IgnoreEvents ignore;
+  if (parser.HandleNextDocument(ignore) && parser.HandleNextDocument(ignore))
+    throw ConfigError(what + " holds more than one YAML document (a line '---' starts a new one): a config "
+                             "is one document");
+  return YAML::Load(text);
 }
 
 }  // namespace
@@ -104,9 +129,12 @@ YamlReader YamlReader::load_file(const std::string& file) {
     throw ConfigError("config file '" + file + "' is a directory, not a YAML file");
   YAML::Node n;
   try {
-    n = single_document(YAML::LoadAllFromFile(file), "config file '" + file + "'");
-  } catch (const YAML::BadFile&) {
-    throw ConfigError("config file '" + file + "' cannot be opened (missing or unreadable)");
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw ConfigError("config file '" + file + "' cannot be opened (missing or unreadable)");
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (in.bad()) throw ConfigError("config file '" + file + "' cannot be read");
+    n = single_document(text.str(), "config file '" + file + "'");
   } catch (const YAML::ParserException& e) {
     throw ConfigError("config file '" + file + "' is not valid YAML: line " + std::to_string(e.mark.line + 1) +
                       ", column " + std::to_string(e.mark.column + 1) + ": " + e.msg);
@@ -119,7 +147,7 @@ YamlReader YamlReader::load_file(const std::string& file) {
 YamlReader YamlReader::load_string(const std::string& text, const std::string& name) {
   YAML::Node n;
   try {
-    n = single_document(YAML::LoadAll(text), "config '" + name + "'");
+    n = single_document(text, "config '" + name + "'");
   } catch (const YAML::ParserException& e) {
     throw ConfigError("config '" + name + "' is not valid YAML: line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }

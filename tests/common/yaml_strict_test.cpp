@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include "abuopt/common/config_error.hpp"
@@ -41,8 +42,22 @@ TEST(YamlStrict, DuplicatesInsideListsAreFoundToo) {
 
 TEST(YamlStrict, ASecondDocumentIsAnError) {
   const std::string m = error_of("abu:\n  friction_mu: 0.02\n---\nabu:\n  friction_mu: 0.5\n");
-  EXPECT_NE(m.find("2 YAML documents"), std::string::npos) << m;
+  EXPECT_NE(m.find("more than one YAML document"), std::string::npos) << m;
   EXPECT_EQ(error_of("abu:\n  friction_mu: 0.02\n"), "");
+}
+
+// Found by fuzz_config: on this malformed config (a study config with a few bytes changed, a tag
+// inside a key) yaml-cpp's LoadAll never stopped collecting empty documents and took gigabytes
+// within a second. Reading it must end at once, with a ConfigError or a (rejected later) node.
+TEST(YamlStrict, AnInputThatMadeLoadAllCollectDocumentsForeverEnds) {
+  std::ifstream in(std::string(ABUOPT_SOURCE_DIR) + "/tests/common/data/loadall_endless_documents.yaml",
+                   std::ios::binary);
+  ASSERT_TRUE(in) << "test input missing";
+  std::ostringstream text;
+  text << in.rdbuf();
+  ASSERT_GT(text.str().size(), 500u);
+  const std::string m = error_of(text.str());
+  EXPECT_NE(m.find("more than one YAML document"), std::string::npos) << m;
 }
 
 TEST(YamlStrict, TheFileIsNamedAndADirectoryIsBadInput) {
