@@ -27,13 +27,13 @@ timed() {
   echo "sanitize: $name $((SECONDS - t0)) s"
 }
 
-# The tests only: no benchmarks. -O1 and line tables only (-gline-tables-only: enough for the
+# The tests only: no benchmarks. -O1 and line tables only (GCC -g1: enough for the
 # sanitizers' stack traces) keep the build and the run fast enough for CI.
 configure() {
   local dir=$1 flags=$2
   shift 2
   cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DABUOPT_BUILD_BENCH=OFF "$@" \
-    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only -fno-omit-frame-pointer $flags" \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -fno-omit-frame-pointer $flags" \
     -DCMAKE_EXE_LINKER_FLAGS="$flags" >/dev/null
 }
 
