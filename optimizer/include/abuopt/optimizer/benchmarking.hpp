@@ -77,6 +77,10 @@ struct ProblemSpec {
   // fresh runs of a seed no optimiser saw); empty: none. Called once per run on the result's x
   // (thread-safe: runs may go at once), never for a run without a point.
   std::function<Evaluation(const std::vector<double>& x)> validate;
+  // What the evaluation archive keys this problem's values by (ComparisonSetup::archive_directory):
+  // a value stored under one identity never answers another. Give a hash of everything that fixes
+  // the values (the startup problem: its archive id); empty: the label.
+  std::string identity;
 };
 
 struct RunRecord;
@@ -88,6 +92,19 @@ struct ComparisonSetup {
   std::string true_objective_metric = "noise_free_objective";
   // Called after each run (e.g. to print progress), in run order; may be empty.
   std::function<void(const RunRecord&)> on_run;
+  // Called as each run ends (a progress line), from the thread that ran it, one call at a time,
+  // with the runs ended so far and the total of the comparison; f* is not known yet, so
+  // evaluations_to_solve is -1. May be empty.
+  std::function<void(const RunRecord&, std::size_t ended, std::size_t total)> on_run_ended;
+  // Resumable comparison: when not empty, every run keeps its evaluations in an evaluation archive
+  // of its own (evaluation_archive.hpp), <archive_directory>/<problem>/start<k>-<solver>.sqlite,
+  // and the out-of-sample checks go into <archive_directory>/<problem>/validation.sqlite. A rerun
+  // answers what is stored bit for bit; the optimisers are deterministic, so an interrupted run
+  // retraces its path from the archive and goes on from where it stopped, and a finished run is
+  // replayed without computing anything (RunRecord::result.archive_hits counts the answers). The
+  // problems' identities key the values (ProblemSpec::identity). No run handles SIGINT itself then:
+  // Ctrl-C ends the comparison at once, and every evaluation stored so far stays.
+  std::string archive_directory;
   // Runs of one problem at once (its starts x solvers are independent); the results do not
   // depend on it (only wall times do). 1: one after another. Each run's own Monte Carlo threads
   // come on top, so for the startup problem keep threads x montecarlo.threads near the cores.
@@ -115,6 +132,7 @@ struct RunRecord {
   // ProblemSpec::validate of result.x (unset without one); feasible within the run's tolerance
   std::optional<Evaluation> validation;
   bool validation_feasible = false;
+  bool validation_from_archive = false;  // the validation was answered by the archive
 };
 
 struct ComparisonResult {
