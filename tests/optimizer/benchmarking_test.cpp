@@ -235,6 +235,14 @@ TEST(Comparison, ReadSolverSpec) {
 
 }  // namespace
 
+// hs071 with the sampled noise: one run's relative noise 0.01, at most 32 runs.
+std::unique_ptr<opt::Problem> sampled_noisy_hs071() {
+  opt::benchmarks::BenchmarkSettings s;
+  s.noise_amplitude = 0.01;
+  s.noise_samples = 32;
+  return opt::benchmarks::make_benchmark("noisy_hs071", s);
+}
+
 // Out-of-sample validation and simulation counts: ProblemSpec::validate is called on every run's
 // result (here the noise-free hs071 at the result of a run on its sampled noisy variant), and
 // runs.csv carries samples, validated_objective, validated_max_violation and validated_feasible.
@@ -242,12 +250,7 @@ TEST(Comparison, ValidatesEveryResultAndCountsSimulations) {
   opt::ComparisonSetup setup;
   opt::ProblemSpec spec;
   spec.label = "sampled_hs071";
-  spec.make = [] {
-    opt::benchmarks::BenchmarkSettings s;
-    s.noise_amplitude = 0.01;
-    s.noise_samples = 32;
-    return opt::benchmarks::make_benchmark("noisy_hs071", s);
-  };
+  spec.make = sampled_noisy_hs071;
   spec.max_evaluations = 40;
   spec.starts = 2;
   spec.constraint_tolerance = 1e-2;
@@ -300,12 +303,7 @@ TEST(Comparison, ArchivesMakeAComparisonResumable) {
     opt::ProblemSpec spec;
     spec.label = "sampled hs071";  // a space: the archive's file names are made safe
     spec.identity = "noisy_hs071/a0.01/n32";
-    spec.make = [] {
-      opt::benchmarks::BenchmarkSettings s;
-      s.noise_amplitude = 0.01;
-      s.noise_samples = 32;
-      return opt::benchmarks::make_benchmark("noisy_hs071", s);
-    };
+    spec.make = sampled_noisy_hs071;
     spec.max_evaluations = budget;
     spec.starts = 2;
     spec.seed = 4;
@@ -340,7 +338,9 @@ TEST(Comparison, ArchivesMakeAComparisonResumable) {
       EXPECT_EQ(x.best_true_objective, y.best_true_objective) << i;
       EXPECT_EQ(x.evaluations_to_solve, y.evaluations_to_solve) << i;
       ASSERT_EQ(x.validation.has_value(), y.validation.has_value()) << i;
-      if (x.validation) EXPECT_EQ(x.validation->objective, y.validation->objective) << i;
+      if (x.validation) {
+        EXPECT_EQ(x.validation->objective, y.validation->objective) << i;
+      }
     }
   };
 
