@@ -51,10 +51,11 @@ asan_test() {
     --output-on-failure -j "$jobs"
 }
 
-tsan_targets=(monte_carlo_test evaluation_archive_test minimize_test startup_profile_problem_test evaluation_batch_test startup_batch_test)
+# Target abuopt_threaded_tests (tests/CMakeLists.txt): monte_carlo_test evaluation_archive_test
+# minimize_test startup_profile_problem_test evaluation_batch_test startup_batch_test.
 tsan_build() {
   configure build-tsan "-fsanitize=thread"
-  cmake --build build-tsan -j "$jobs" --target "${tsan_targets[@]}"
+  cmake --build build-tsan -j "$jobs" --target abuopt_threaded_tests
 }
 tsan_test() {
   # setarch -R: kernels with 28+ bits of mmap randomisation break TSan's memory layout
