@@ -107,10 +107,18 @@ std::vector<std::vector<double>> starting_points(const Problem& problem, int sta
   return out;
 }
 
-long evaluations_to_solve(const OptimizationResult& result, double f_star, double tau, const std::string& metric) {
+bool counts_as_problem_value(const EvaluationRecord& h, std::size_t full_sample_size, const std::string& metric) {
+  if (full_sample_size == 0 || (!metric.empty() && h.metrics.count(metric))) return true;
+  const auto runs = h.metrics.find("runs");
+  return runs == h.metrics.end() || runs->second >= static_cast<double>(full_sample_size);
+}
+
+long evaluations_to_solve(const OptimizationResult& result, double f_star, double tau, const std::string& metric,
+                          std::size_t full_sample_size) {
   const double threshold = solved_threshold(f_star, tau);
   for (const EvaluationRecord& h : result.history)
-    if (h.feasible && true_objective(h, metric) - f_star <= threshold) return h.index + 1;
+    if (h.feasible && counts_as_problem_value(h, full_sample_size, metric) && true_objective(h, metric) - f_star <= threshold)
+      return h.index + 1;
   return -1;
 }
 
@@ -249,6 +257,7 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
         rec.solver = solver.label;
         rec.start = k;
         rec.dimension = problem->dimension();
+        rec.sample_size = problem->sample_size();
         rec.x0 = starts[k];
         try {
           if (solver.then) {
@@ -274,7 +283,7 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
         }
         double best = kInf;
         for (const EvaluationRecord& h : rec.result.history) {
-          if (!h.feasible) continue;
+          if (!h.feasible || !counts_as_problem_value(h, rec.sample_size, setup.true_objective_metric)) continue;
           const double f = true_objective(h, setup.true_objective_metric);
           if (f < best) {
             best = f;
@@ -327,7 +336,9 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
     for (std::size_t i = first_run; i < out.runs.size(); ++i) {
       RunRecord& rec = out.runs[i];
       rec.evaluations_to_solve =
-          std::isfinite(f_star) ? evaluations_to_solve(rec.result, f_star, setup.tau, setup.true_objective_metric) : -1;
+          std::isfinite(f_star) ? evaluations_to_solve(rec.result, f_star, setup.tau, setup.true_objective_metric,
+                                                      rec.sample_size)
+                               : -1;
       if (setup.on_run) setup.on_run(rec);
     }
   }

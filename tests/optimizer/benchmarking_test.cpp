@@ -81,6 +81,33 @@ TEST(Profiles, EvaluationsToSolve) {
   EXPECT_EQ(opt::evaluations_to_solve(z, 0.0, 0.01), 1);
 }
 
+// A sampled problem (own size 256): a value on 64 runs (adaptive sample size) does not count as a
+// value of the problem unless it carries the noise-free metric; at 256 runs, or without a `runs`
+// metric, or for a problem that is not sampled, it does.
+TEST(Profiles, ValuesOnFewerRunsDoNotCount) {
+  opt::OptimizationResult r;
+  auto add = [&](double f, double runs) {
+    opt::EvaluationRecord h;
+    h.index = static_cast<long>(r.history.size());
+    h.objective = f;
+    h.feasible = true;
+    h.metrics["runs"] = runs;
+    r.history.push_back(h);
+  };
+  add(10.05, 64);   // 1: within 1 % of 10, but on 64 runs
+  add(10.5, 256);   // 2: on 256 runs, not within
+  add(10.08, 256);  // 3: within, on 256 runs
+  EXPECT_EQ(opt::evaluations_to_solve(r, 10.0, 0.01, "noise_free_objective", 256), 3);
+  EXPECT_EQ(opt::evaluations_to_solve(r, 10.0, 0.01, "noise_free_objective", 0), 1);   // not sampled
+  EXPECT_EQ(opt::evaluations_to_solve(r, 10.0, 0.01, "noise_free_objective", 64), 1);  // own size 64
+  r.history[0].metrics["noise_free_objective"] = 10.05;  // a noise-free value counts at any size
+  EXPECT_TRUE(opt::counts_as_problem_value(r.history[0], 256, "noise_free_objective"));
+  EXPECT_EQ(opt::evaluations_to_solve(r, 10.0, 0.01, "noise_free_objective", 256), 1);
+  r.history[1].metrics.erase("runs");
+  EXPECT_TRUE(opt::counts_as_problem_value(r.history[1], 256, "noise_free_objective"));
+  EXPECT_FALSE(opt::counts_as_problem_value(r.history[0], 256, ""));
+}
+
 TEST(Profiles, SolveMatrixFromRuns) {
   opt::ComparisonResult c;
   c.solvers = {"A", "B"};

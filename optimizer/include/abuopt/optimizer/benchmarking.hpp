@@ -123,6 +123,7 @@ struct RunRecord {
   std::string solver;
   int start = 0;                   // index of the starting point
   std::size_t dimension = 0;       // n_p
+  std::size_t sample_size = 0;     // the problem's own Monte Carlo size (Problem::sample_size())
   std::vector<double> x0;
   OptimizationResult result;       // with its history
   double best_true_objective = std::numeric_limits<double>::infinity();  // best feasible (true f)
@@ -159,7 +160,16 @@ std::vector<std::vector<double>> starting_points(const Problem& problem, int sta
 
 // Evaluations until the first feasible point with f - f* <= tau max(|f*|, 1); -1 if none.
 long evaluations_to_solve(const OptimizationResult& result, double f_star, double tau,
-                          const std::string& true_objective_metric = "noise_free_objective");
+                          const std::string& true_objective_metric = "noise_free_objective",
+                          std::size_t full_sample_size = 0);
+// Whether an evaluation counts as a value of the problem (for "solved", the best value and the
+// convergence curve): always, unless the problem is sampled (full_sample_size > 0, its own Monte
+// Carlo size), the evaluation has no true_objective_metric (a noise-free value) and its metric
+// `runs` is below full_sample_size: a value of SAO's adaptive sample size on fewer runs is an
+// estimate of another, noisier statistic (its minimum over many designs is biased low), so a
+// comparison judges every solver on values at the problem's own size.
+bool counts_as_problem_value(const EvaluationRecord& h, std::size_t full_sample_size,
+                             const std::string& true_objective_metric);
 
 // ---- profile arithmetic (t: rows = instances, columns = solvers, +inf = not solved) ----
 // d_s(alpha) for each alpha: fraction of rows with t[p][s] <= alpha (dims[p] + 1).
