@@ -184,9 +184,10 @@ int handle_contact_event(RunState& rs, double tbar, std::vector<double>& y, cons
     bool hit = false;
     for (std::size_t i : grp) hit = hit || struck[i];
     if (mode == BallMode::Stick) {
-      bool fired = false;
-      for (std::size_t i : grp) fired = fired || rinfo[2 * i] != 0 || rinfo[2 * i + 1] != 0;
-      for (std::size_t i : grp) forced[i] = fired && !hit;
+      char fired = 0;  // the directions whose margins crossed
+      for (std::size_t i : grp)
+        fired |= static_cast<char>((rinfo[2 * i] != 0 ? kForcedForward : 0) | (rinfo[2 * i + 1] != 0 ? kForcedBackward : 0));
+      for (std::size_t i : grp) forced[i] = hit ? 0 : fired;
     } else if (rinfo[2 * grp.back()] != 0 && !hit) {
       for (std::size_t i : grp) y[lay.beta_dot(i)] = 0.0;  // the cluster stopped
     }
