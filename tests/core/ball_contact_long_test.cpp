@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "abuopt/core/ball_contact.hpp"
@@ -54,6 +55,8 @@ TEST(BallContactLong, NoFinalStateOverlapsIn1024RandomStartsFourBallsBothStuckIn
       }
       overlaps += min_contact_clearance(s.abu, o.beta_final) < -1e-12;
     }
+    std::printf("four balls, %s stuck integrator: %d of 1024 runs failed, %d overlaps\n", to_string(stuck).c_str(),
+                failed, overlaps);
     EXPECT_EQ(overlaps, 0) << to_string(stuck);
     EXPECT_LE(failed, 20) << to_string(stuck);
   }
