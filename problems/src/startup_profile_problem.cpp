@@ -66,6 +66,7 @@ StartupProfileProblem::StartupProfileProblem(StartupProfileSettings settings) : 
   if (c.max_amplitude_mm) constraint_names_.push_back("amplitude");
   if (c.max_pct_mi) constraint_names_.push_back("pct_mi");
   if (c.max_angular_acceleration_rad_s2) constraint_names_.push_back("angular_acceleration");
+  if (c.max_mean_abs_ir) constraint_names_.push_back("mean_abs_ir");
 }
 
 std::vector<std::string> StartupProfileProblem::inequality_names() const { return constraint_names_; }
@@ -197,6 +198,7 @@ opt::Evaluation StartupProfileProblem::evaluate_with_threads(const StartupProfil
       case ObjectiveKind::Mean: return mean;
       case ObjectiveKind::PctMi: return pct;
       case ObjectiveKind::Weighted: return os.weight_mean * mean + os.weight_pct_mi * pct;
+      case ObjectiveKind::StartupTime: return profile.duration_s();
       case ObjectiveKind::SmoothPctMi:
       case ObjectiveKind::Quantile:
       case ObjectiveKind::Cvar: {
@@ -314,6 +316,7 @@ opt::Evaluation StartupProfileProblem::evaluate_with_threads(const StartupProfil
   double obj = 0;
   for (double v : objectives) obj += v;
   e.objective = obj / static_cast<double>(objectives.size());
+  if (os.kind == ObjectiveKind::StartupTime) e.objective = profile.duration_s();  // exact, not an average
 
   const ConstraintSettings& c = settings_.constraints;
   std::vector<double> g;
@@ -325,6 +328,7 @@ opt::Evaluation StartupProfileProblem::evaluate_with_threads(const StartupProfil
   if (c.max_pct_mi) g.push_back((smooth_constraint ? smooth.pct_mi : ir(all).pct_mi) / *c.max_pct_mi - 1.0);
   if (c.max_angular_acceleration_rad_s2)
     g.push_back(peak_angular_acceleration_rad_s2(profile) / *c.max_angular_acceleration_rad_s2 - 1.0);
+  if (c.max_mean_abs_ir) g.push_back(all.magnitude.mean / kUnit / *c.max_mean_abs_ir - 1.0);
   e.inequality = std::move(g);
   return e;
 }

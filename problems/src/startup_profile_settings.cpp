@@ -66,7 +66,8 @@ const EnumNames<ObjectiveKind> kObjectiveKindNames = {
     {ObjectiveKind::Weighted, "weighted"},
     {ObjectiveKind::SmoothPctMi, "smooth_pct_mi"},
     {ObjectiveKind::Quantile, "quantile"},
-    {ObjectiveKind::Cvar, "cvar"}};
+    {ObjectiveKind::Cvar, "cvar"},
+    {ObjectiveKind::StartupTime, "startup_time"}};
 const EnumNames<PctMiStatistic> kPctMiStatisticNames = {{PctMiStatistic::Exact, "exact"},
                                                         {PctMiStatistic::Smooth, "smooth"}};
 const EnumNames<ImbalanceDefinition> kImbalanceDefinitionNames = {{ImbalanceDefinition::Magnitude, "magnitude"},
@@ -155,6 +156,9 @@ void describe_fields(FieldArchive& a, ConstraintSettings& c) {
   a.field("max_amplitude_mm", c.max_amplitude_mm, Rule::positive());
   a.field("max_pct_mi", c.max_pct_mi, Rule::in_range(1e-9, 100.0));
   a.field("max_angular_acceleration_rad_s2", c.max_angular_acceleration_rad_s2, Rule::positive());
+  FieldOptions mean_bound;  // written (and in the identity) only when set: older problems keep their ids
+  mean_bound.enabled = a.reading() || c.max_mean_abs_ir.has_value();
+  a.field("max_mean_abs_ir", c.max_mean_abs_ir, Rule::positive(), mean_bound);
   a.field("amplitude", c.amplitude, kAmplitudeStatisticNames);
   a.field("penalty_weight", c.penalty_weight, Rule::non_negative());
   FieldOptions statistic;  // written (and in the identity) only when not the default exact count
@@ -261,6 +265,7 @@ void validate(const StartupProfileSettings& s) {
   positive(c.max_amplitude_mm, "constraints.max_amplitude_mm");
   positive(c.max_pct_mi, "constraints.max_pct_mi");
   positive(c.max_angular_acceleration_rad_s2, "constraints.max_angular_acceleration_rad_s2");
+  positive(c.max_mean_abs_ir, "constraints.max_mean_abs_ir");
   if (!(std::isfinite(c.penalty_weight) && c.penalty_weight >= 0))
     throw ConfigError("constraints.penalty_weight", format_number(c.penalty_weight), "must be >= 0");
   if (s.validation.runs < 1) throw ConfigError("validation.runs", "0", "must be >= 1");
