@@ -45,16 +45,22 @@ asan_build() {
   bash scripts/fuzz.sh --build-only
   cmake --build build-asan -j "$jobs" --target abuopt_library_tests
 }
+# Three tests are left out of this step: they repeat code paths the others cover on many more
+# starts (random starts of the study profiles with 1 Hz setpoints; SAO's adaptive sample size and
+# global phase from 12 and 5 random starts) and took 159, 132 and 60 s of the step's 495 s of test
+# time under ASan. They run in the default suite.
+asan_slow="QuantisedReference[.]RandomStartsOfTheStudyProfilesAllFinish|SaoSampling[.]FewerSimulationsThanFixedSizeOnNoisyBenchmarks|SaoGlobal[.]Hs071FromRandomStartsReachesTheGlobalOptimum"
 asan_test() {
   ASAN_OPTIONS=detect_leaks=1:strict_string_checks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    ctest --test-dir build-asan -LE long -E "_NOT_BUILT$|Cli[.]|^package_" \
+    ctest --test-dir build-asan -LE long -E "_NOT_BUILT$|Cli[.]|^package_|$asan_slow" \
     --output-on-failure -j "$jobs"
 }
 
-tsan_targets=(monte_carlo_test evaluation_archive_test minimize_test startup_profile_problem_test evaluation_batch_test startup_batch_test)
+# Target abuopt_threaded_tests (tests/CMakeLists.txt): monte_carlo_test evaluation_archive_test
+# minimize_test startup_profile_problem_test evaluation_batch_test startup_batch_test.
 tsan_build() {
   configure build-tsan "-fsanitize=thread"
-  cmake --build build-tsan -j "$jobs" --target "${tsan_targets[@]}"
+  cmake --build build-tsan -j "$jobs" --target abuopt_threaded_tests
 }
 tsan_test() {
   # setarch -R: kernels with 28+ bits of mmap randomisation break TSan's memory layout
