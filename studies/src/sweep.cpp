@@ -216,6 +216,7 @@ std::string objective_label(const problems::StartupProfileSettings& s) {
     case ObjectiveKind::SmoothPctMi: return "smoothed %MI (" + ir + ") [%]";
     case ObjectiveKind::Quantile: return "quantile of " + ir + " [1e-7 kg m]";
     case ObjectiveKind::Cvar: return "CVaR of " + ir + " [1e-7 kg m]";
+    case ObjectiveKind::StartupTime: return "startup time [s]";
   }
   return "objective";
 }

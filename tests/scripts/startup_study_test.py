@@ -130,7 +130,16 @@ def end_to_end(abuopt, tmp):
     check(all(f"{nb}_{n}" in s["balls"] for nb in range(2, 7) for n in ("report_2003", "reoptimised", "f1_design"))
           and all(int(k.split("_")[0]) in range(2, 7) for k in s["balls"]),
           "formulation 4: 2..6 balls, re-optimised, f1 design and 2003 each")
-    check(len(s["f2"]["steps"]) >= 1 and s["f2"]["ref"]["runs"] == 5, "formulation 2: bisection steps recorded")
+    check(len(s["f2"]["steps"]) == 4 and s["f2"]["ref"]["runs"] == 5 and
+          {r["start"] for r in s["f2"]["steps"]} == {"front6", "front8", "front11", "sweep19_scaled8"},
+          "formulation 2: one startup-time minimisation per start recorded")
+    f2cfg = study.read(os.path.join(out, "f2_front8", "config.yaml"))
+    check("kind: startup_time" in f2cfg and "max_mean_abs_ir:" in f2cfg and "max_startup_time_s: 19" in f2cfg,
+          "formulation 2 minimises startup_time with the max_mean_abs_ir bound")
+    cost = json.load(open(os.path.join(out, "stage_cost.json")))
+    stages = [c["stage"] for c in cost]
+    check(len(stages) == 8 and all(c["cpu_s"] >= 0 and c["wall_s"] >= 0 for c in cost) and cost[0]["cpu_s"] > 0
+          and "[cost] whole study: CPU" in r.stdout, f"the cost of every stage is recorded: {stages}")
     configs = [os.path.join(d, "config.yaml") for d in
                [os.path.join(out, x) for x in os.listdir(out)] + [os.path.join(out, "validation", x) for x in
                                                                    os.listdir(os.path.join(out, "validation"))]

@@ -21,6 +21,9 @@
 //              optimisers; validation and reports stay on the exact ones. With them (and with
 //              constraints.pct_mi_statistic: smooth) the metrics add pct_mi_smooth, ir_quantile,
 //              ir_cvar and smoothing_bandwidth.
+//   startup_time: T = the sum of the durations [s] (exact, no noise; the Monte Carlo still runs for
+//              the constraints and metrics): "the least startup time with a given quality", with
+//              constraints.max_mean_abs_ir and max_pct_mi.
 // Robust (objective.robust.friction_mu = [mu_1..mu_K]): the objective is the average over k of the
 // objective of the Monte Carlo run with friction fixed to mu_k (same initial conditions for every
 // k); constraints and metrics use the pooled statistics of all K x runs runs (pooled %MI = average
@@ -32,6 +35,8 @@
 //                  (amplitude: max, default) or the mean over runs of it (amplitude: mean)
 //   pct_mi:        %MI / max_pct_mi - 1 <= 0                    (definition of the objective; the
 //                  smoothed exceedance with constraints.pct_mi_statistic: smooth)
+//   mean_abs_ir:   mean |I_r| / max_mean_abs_ir - 1 <= 0        (always |I_r|, pooled over the robust set;
+//                  the Monte Carlo's mean, in 1e-7 kg m)
 //   angular_acceleration: a / max_angular_acceleration_rad_s2 - 1 <= 0, a = peak_angular_acceleration_rad_s2
 // The problem always declares its constraints. With constraints.penalty_weight = w > 0 the
 // optimisers see its penalty form instead (make_startup_profile_problem, opt::PenaltyProblem): no
@@ -85,10 +90,10 @@ struct ProfileDesign {
   std::vector<SegmentDesign> segments;
 };
 
-enum class ObjectiveKind { Mean, PctMi, Weighted, SmoothPctMi, Quantile, Cvar };
+enum class ObjectiveKind { Mean, PctMi, Weighted, SmoothPctMi, Quantile, Cvar, StartupTime };
 enum class ImbalanceDefinition { Magnitude, ReportX };
 enum class AmplitudeStatistic { Max, Mean };
-// mean, pct_mi, weighted, smooth_pct_mi, quantile, cvar
+// mean, pct_mi, weighted, smooth_pct_mi, quantile, cvar, startup_time
 extern const EnumNames<ObjectiveKind> kObjectiveKindNames;
 extern const EnumNames<ImbalanceDefinition> kImbalanceDefinitionNames;  // magnitude, report_x
 extern const EnumNames<AmplitudeStatistic> kAmplitudeStatisticNames;    // max, mean
@@ -118,6 +123,8 @@ struct ConstraintSettings {
   std::optional<double> max_amplitude_mm;
   AmplitudeStatistic amplitude = AmplitudeStatistic::Max;
   std::optional<double> max_pct_mi;
+  // Mean |I_r| over the runs (pooled over the robust set) [1e-7 kg m], whatever objective.definition.
+  std::optional<double> max_mean_abs_ir;
   PctMiStatistic pct_mi_statistic = PctMiStatistic::Exact;
   // Peak angular acceleration of the profile, max over segments of 2 pi * 2 |H| / dt [rad/s^2]
   // (exact, no noise): what the drive must be able to follow.

@@ -1,0 +1,199 @@
+#!/usr/bin/env python3
+"""Where balls stop when they slide into the equilibrium set: the stop depth against the approach rate
+(issue 10, the limit analysis of docs/studies/startup-profile.md section 8.9).
+
+A profile decides how the balls enter the set of the speed at which they stop through the rate at which
+it approaches that speed. This runner measures it directly: for a hold frequency f_h and an approach
+duration D,
+
+    up:    0 -> 25 Hz in 1 s, 25 Hz -> f_h in D (inclined sine), hold f_h for 6 s, -> 100 Hz in 4.3 s
+    down:  0 -> 25 Hz in 1 s, -> 30 Hz in 5 s, 30 Hz -> f_h in D (the sweep back of the best designs),
+           hold f_h for 6 s, -> 100 Hz in 4.3 s
+
+each on the same random starts (abuopt montecarlo), and reports per case the final |I_r| in units of
+r_lock(mu) (mean, p10, median, p90, the share at or below the goal's 0.44 r_lock) and the stop depth
+|I_r| / r_in(f_s) at each run's settling frequency f_s (r_in: the inscribed disc of the set,
+docs/equilibrium_sets.md section 4; 1 = on the boundary, 0 = at a balancing point).
+
+    python3 scripts/stop_depth_study.py --out results/stop_depth [--runs 1024] [--mu 0.02 0.03]
+
+Writes OUT/stop_depth.csv, OUT/stop_depth.md and OUT/stop_depth.png (gnuplot). Needs python3 only.
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+# The report's ABU (spec table 3.2; configs/eqset.yaml): M = table + imbalance + two balls.
+TABLE_MASS, IMB_MASS, ECC, BALL_MASS, L = 0.324, 5.6e-4, 3.7e-3, 1.4e-4, 1.15e-2
+DAMPING, STIFFNESS = 1.28, 1.07e4
+M = TABLE_MASS + IMB_MASS + 2 * BALL_MASS
+OMEGA_N = math.sqrt(STIFFNESS / M)
+BBAR = DAMPING / (2 * math.sqrt(STIFFNESS * M))
+GOAL_FRACTION = 0.44  # 7.0e-7 / r_lock(0.02): the mean-|I_r| goal in units of r_lock
+HOLD_S, LAST_S, FIRST = 6.0, 4.3, (25.0, 1.0)
+
+
+def r_in(f_hz, mu):
+    """Inscribed disc of the set at f [1e-7 kg m]: M L mu / ((1 + mu) |G(W)|), G = W^2 / (1 - W^2 + 2 i bbar W)."""
+    w = 2 * math.pi * f_hz / OMEGA_N
+    g = w * w / abs(complex(1 - w * w, 2 * BBAR * w))
+    return M * L * mu / ((1 + mu) * g) / 1e-7
+
+
+def r_lock(mu):
+    """min_f r_in(f) = 2 bbar sqrt(1 - bbar^2) M L mu / (1 + mu) [1e-7 kg m] (15.90 at mu = 0.02)."""
+    return 2 * BBAR * math.sqrt(1 - BBAR * BBAR) * M * L * mu / (1 + mu) / 1e-7
+
+
+def segments(kind, f_h, d):
+    s = [FIRST]
+    if kind == "down":
+        s.append((30.0, 5.0))
+    return s + [(f_h, d), (f_h, HOLD_S), (100.0, LAST_S)]
+
+
+def frequency_at(segs, t):
+    """The profile's frequency at time t (inclined sines from 0 Hz)."""
+    t0, f0 = 0.0, 0.0
+    for fe, dt in segs:
+        if t <= t0 + dt:
+            phi = 2 * math.pi * (t - t0) / dt
+            return f0 + (fe - f0) / (2 * math.pi) * (phi - math.sin(phi))
+        t0, f0 = t0 + dt, fe
+    return f0
+
+
+def config_text(segs, mu, runs, seed):
+    prof = "".join(f"    - {{end_frequency_hz: {f:.6g}, duration_s: {d:.6g}}}\n" for f, d in segs)
+    return (f"abu:\n  friction_mu: {mu}\n  ball_contact: hard\nprofile:\n  start_frequency_hz: 0\n  segments:\n{prof}"
+            "motor:\n  kind: ideal\nsimulation:\n  method: event_driven\n  rtol: 1.0e-6\n"
+            f"montecarlo:\n  design: random\n  runs: {runs}\n  seed: {seed}\n  threads: 0\n")
+
+
+def quantile(v, q):
+    s = sorted(v)
+    return s[min(len(s) - 1, int(q * len(s)))]
+
+
+def run_case(a, kind, f_h, d, mu):
+    segs = segments(kind, f_h, d)
+    name = f"{kind}_f{f_h:g}_D{d:g}_mu{mu:g}"
+    out = os.path.join(a.out, name)
+    os.makedirs(out, exist_ok=True)
+    cfg = os.path.join(out, "config.yaml")
+    text = config_text(segs, mu, a.runs, a.seed)
+    summary = os.path.join(out, "summary.json")
+    if not (os.path.exists(summary) and os.path.exists(cfg) and open(cfg).read() == text):  # resumable
+        with open(cfg, "w") as f:
+            f.write(text)
+        r = subprocess.run(["nice", "-n", str(a.nice), a.abuopt, "montecarlo", cfg, "--threads", str(a.threads),
+                            "--out", out], capture_output=True, text=True)
+        if r.returncode not in (0, 3):
+            sys.exit(f"abuopt montecarlo failed on {cfg} (status {r.returncode}):\n{r.stderr}")
+    rows = [r for r in csv.DictReader(open(os.path.join(out, "runs.csv"))) if r["status"] == "ok"]
+    rl = r_lock(mu)
+    ir = [float(r["ir_magnitude_kgm"]) / 1e-7 for r in rows]
+    depth = [float(r["ir_magnitude_kgm"]) / 1e-7 / r_in(frequency_at(segs, float(r["settling_time_s"])), mu)
+             for r in rows if r["settled"] == "1"]
+    n = len(ir)
+    mean = sum(ir) / n
+    sd = math.sqrt(sum((x - mean) ** 2 for x in ir) / (n - 1))
+    with open(summary) as f:
+        wall = json.load(f).get("wall_time_s", float("nan"))
+    peak_rate = 2 * abs(f_h - (30.0 if kind == "down" else 25.0)) / d  # Hz/s at the middle of the approach
+    return {"kind": kind, "f_hold_hz": f_h, "approach_s": d, "approach_peak_hz_s": peak_rate, "mu": mu,
+            "r_lock": rl, "runs": len(rows), "mean": mean, "hw95": 1.96 * sd / math.sqrt(n),
+            "mean_over_rlock": mean / rl, "p10_over_rlock": quantile(ir, 0.1) / rl,
+            "median_over_rlock": quantile(ir, 0.5) / rl, "p90_over_rlock": quantile(ir, 0.9) / rl,
+            "share_at_goal_depth": sum(1 for x in ir if x <= GOAL_FRACTION * rl) / n,
+            "depth_median": quantile(depth, 0.5) if depth else float("nan"),
+            "depth_p10": quantile(depth, 0.1) if depth else float("nan"),
+            "depth_p90": quantile(depth, 0.9) if depth else float("nan"),
+            "wall_s": wall}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--out", default=os.path.join("results", "stop_depth"))
+    ap.add_argument("--abuopt", default=os.path.join(ROOT, "build", "app", "abuopt"))
+    ap.add_argument("--runs", type=int, default=1024)
+    ap.add_argument("--seed", type=int, default=9001)
+    ap.add_argument("--threads", type=int, default=0)
+    ap.add_argument("--nice", type=int, default=10)
+    ap.add_argument("--mu", type=float, nargs="+", default=[0.02, 0.03])
+    ap.add_argument("--hold", type=float, nargs="+", default=[28.85, 29.0, 29.2])
+    ap.add_argument("--approach", type=float, nargs="+", default=[0.25, 0.5, 1, 2, 4, 8, 16, 32])
+    a = ap.parse_args()
+    if a.runs < 2:
+        sys.exit(f"--runs {a.runs}: must be >= 2")
+    if not os.access(a.abuopt, os.X_OK):
+        sys.exit(f"--abuopt {a.abuopt}: not an executable")
+    os.makedirs(a.out, exist_ok=True)
+    rows = []
+    for mu in a.mu:
+        for kind in ("up", "down"):
+            for f_h in a.hold:
+                for d in a.approach:
+                    r = run_case(a, kind, f_h, d, mu)
+                    rows.append(r)
+                    print(f"{kind:4s} f_h {f_h:6.2f} Hz D {d:6.2f} s mu {mu:.2f}: mean {r['mean']:6.2f} "
+                          f"= {r['mean_over_rlock']:.3f} r_lock, <= 0.44 r_lock {100 * r['share_at_goal_depth']:5.1f} %, "
+                          f"depth median {r['depth_median']:.2f}", flush=True)
+    keys = list(rows[0])
+    with open(os.path.join(a.out, "stop_depth.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=keys)
+        w.writeheader()
+        w.writerows(rows)
+    lines = [f"# Stop depth against the approach ({a.runs} random starts, seed {a.seed}, contact hard)", "",
+             "| approach | f_h [Hz] | D [s] | peak rate [Hz/s] | mu | mean \\|I_r\\| [95 %] | mean / r_lock | p10 | median | "
+             "p90 | share <= 0.44 r_lock | depth median (p10, p90) |",
+             "|" + "---|" * 12]
+    for r in rows:
+        lines.append(f"| {r['kind']} | {r['f_hold_hz']:g} | {r['approach_s']:g} | {r['approach_peak_hz_s']:.2f} | "
+                     f"{r['mu']:g} | {r['mean']:.2f} +- {r['hw95']:.2f} | {r['mean_over_rlock']:.3f} | "
+                     f"{r['p10_over_rlock']:.3f} | {r['median_over_rlock']:.3f} | {r['p90_over_rlock']:.3f} | "
+                     f"{100 * r['share_at_goal_depth']:.1f} % | {r['depth_median']:.2f} ({r['depth_p10']:.2f}, "
+                     f"{r['depth_p90']:.2f}) |")
+    best = min(rows, key=lambda r: r["mean_over_rlock"])
+    lines += ["", f"least mean / r_lock: {best['mean_over_rlock']:.3f} ({best['kind']}, f_h {best['f_hold_hz']:g} Hz, "
+              f"D {best['approach_s']:g} s, mu {best['mu']:g}); the goal needs {GOAL_FRACTION}"]
+    with open(os.path.join(a.out, "stop_depth.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    print("\n".join(lines[-1:]))
+    # Plot: mean |I_r| / r_lock (p10..p90 bars) against the approach duration, per case.
+    gp = shutil.which("gnuplot")
+    dat = os.path.join(a.out, "stop_depth.dat")
+    series = []
+    with open(dat, "w") as f:
+        for mu in a.mu:
+            for kind in ("up", "down"):
+                for f_h in a.hold:
+                    f.write(f"# {kind} {f_h} {mu}\n")
+                    for r in rows:
+                        if (r["kind"], r["f_hold_hz"], r["mu"]) == (kind, f_h, mu):
+                            f.write(f"{r['approach_s']} {r['mean_over_rlock']:.4f} {r['median_over_rlock']:.4f} "
+                                    f"{r['share_at_goal_depth']:.4f}\n")
+                    f.write("\n\n")
+                    series.append(f"{kind} to {f_h:g} Hz, mu {mu:g}")
+    plots = ", ".join(f"'stop_depth.dat' index {k} using 1:2 with linespoints lw 1.5 dt {1 if 'up' in s else 2} "
+                      f"pt {k % 13 + 1} title '{s}'" for k, s in enumerate(series))
+    gpf = os.path.join(a.out, "stop_depth.gp")
+    with open(gpf, "w") as f:
+        f.write("set terminal pngcairo size 1000,650 noenhanced\nset output 'stop_depth.png'\nset grid\n"
+                f"set title 'mean |I_r| / r_lock(mu) against the approach duration ({a.runs} starts, contact hard)'\n"
+                "set xrange [0.2:40]\nset xlabel 'approach duration D to the hold frequency [s] (log)'\nset logscale x\n"
+                "set ylabel 'mean |I_r| / r_lock(mu)'\nset yrange [0:1.4]\nset key outside right\n"
+                f"plot {plots}, {GOAL_FRACTION} with lines lw 2 lc rgb 'black' title 'goal 7.0e-7 = 0.44 r_lock'\n")
+    if gp:
+        subprocess.run([gp, "stop_depth.gp"], cwd=a.out, capture_output=True)
+
+
+if __name__ == "__main__":
+    main()
