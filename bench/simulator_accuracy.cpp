@@ -2,6 +2,7 @@
 // random initial conditions of the report's final profile (not a Google Benchmark: it prints a
 // table). Usage: simulator_accuracy [runs=1024] [rtol=1e-6] [reference_rtol=1e-10] [table]
 //   [stuck_integrator=default] [reference_stuck_integrator=default]   (rk or exact)
+//   [ball_contact=none]   (none or hard: both settings with that ball contact)
 // Reports: the largest final-angle difference, how many runs differ by more than 1e-3 rad,
 // and the mean CPU time per run of both settings.
 #include <algorithm>
@@ -40,6 +41,14 @@ int main(int argc, char** argv) {
   };
   if (argc > 5 && std::string(argv[5]) != "default") fast.options.stuck_integrator = stuck(argv[5]);
   if (argc > 6 && std::string(argv[6]) != "default") ref.options.stuck_integrator = stuck(argv[6]);
+  if (argc > 7) {
+    const std::string c = argv[7];
+    if (c != "none" && c != "hard") {
+      std::fprintf(stderr, "ball contact must be none or hard, not '%s'\n", c.c_str());
+      return 2;
+    }
+    fast.abu.ball_contact = ref.abu.ball_contact = c == "hard" ? BallContact::Hard : BallContact::None;
+  }
   fast.options.rtol = rtol;
   fast.options.atol = rtol * 1e-3;
   ref.options.rtol = ref_rtol;

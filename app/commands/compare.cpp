@@ -22,8 +22,14 @@
 //   solvers:
 //     - {label: SAO, algorithm: sao, sao: {...}}
 //     - {label: COBYLA, algorithm: cobyla, options: {...}}   # options: the optimizer: keys
+//
+// Resumable: every run keeps its evaluations in OUT/archive/<problem>/start<k>-<solver>.sqlite (and
+// the validations in OUT/archive/<problem>/validation.sqlite); the same command with the same --out
+// after a Ctrl-C or a kill answers them bit for bit, so finished runs cost no simulation and the
+// interrupted ones go on where they stopped. One progress line per run on stderr, with an ETA.
 #include <chrono>
 #include <ctime>
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -69,6 +75,7 @@ opt::ProblemSpec read_startup_profile_problem(YamlReader& r) {
   section.finish();
   problems::StartupProfileProblem check(settings);  // a bad design is a ConfigError now, before any run
   spec.label = r.get_string_or("label", "startup_profile");
+  spec.identity = check.identity();  // the archive id of `optimize` on the same sections
   // under mpirun every evaluation's Monte Carlo is spread over the ranks; the comparison's runs
   // (starts x solvers, `threads` at once) share them: their studies go into one pool of runs
   std::shared_ptr<BatchRunner> runner;
@@ -110,6 +117,9 @@ opt::ProblemSpec read_problem(YamlReader& r) {
                                             ? name + std::to_string(settings.dimension)
                                             : name);
   spec.make = [name, settings] { return opt::benchmarks::make_benchmark(name, settings); };
+  // everything that fixes the benchmark's values, as the archive's problem id
+  spec.identity = name + "/d" + std::to_string(settings.dimension) + "/a" + opt::format_number(settings.noise_amplitude) +
+                  "/s" + std::to_string(settings.noise_seed) + "/n" + std::to_string(settings.noise_samples);
   read_run_settings(r, spec);
   r.finish();
   return spec;
@@ -145,25 +155,41 @@ int run_compare(const CompareArgs& a) {
 
   std::size_t total = 0;
   for (const auto& p : setup.problems) total += static_cast<std::size_t>(p.starts) * setup.solvers.size();
-  std::size_t done = 0;
+  const std::string out = a.out.empty() ? "results/compare-" + timestamp() : a.out;
+  const OutputDirLock lock(out);  // one run per output directory (created here)
+  // every run keeps its evaluations in OUT/archive/: a rerun of a killed comparison resumes
+  setup.archive_directory = (std::filesystem::path(out) / "archive").string();
   ProgressReporter bar("compare", "runs", total, a.progress ? ProgressMode::Always : ProgressMode::Auto);
-  setup.on_run = [&](const opt::RunRecord& r) {
-    ++done;
+  // ETA from the runs that computed something (replayed runs take no time): the wall time so far per
+  // such run, times the runs still to go
+  const auto started = std::chrono::steady_clock::now();
+  std::size_t computed_runs = 0;
+  long computed_evaluations = 0, archived_evaluations = 0;
+  setup.on_run_ended = [&](const opt::RunRecord& r, std::size_t ended, std::size_t all) {
+    const long computed = r.result.evaluations - r.result.archive_hits;
+    computed_evaluations += computed;
+    archived_evaluations += r.result.archive_hits;
+    if (computed > 0) ++computed_runs;
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     std::ostringstream line;
-    line << "[" << done << "/" << total << "] " << r.problem << " start " << r.start << " " << r.solver << ": "
+    line << "[" << ended << "/" << all << "] " << r.problem << " start " << r.start << " " << r.solver << ": "
          << r.result.brief_report();
     if (r.result.samples > 0) line << "; " << r.result.samples << " simulations";
     if (r.validation)
       line << "; out of sample f = " << opt::format_number(r.validation->objective)
            << (r.validation_feasible ? " feasible" : " infeasible (violation " +
-                                                         opt::format_number(opt::max_constraint_violation(*r.validation)) + ")");
+                                                         opt::format_number(opt::max_constraint_violation(*r.validation)) + ")")
+           << (r.validation_from_archive ? " [archive]" : "");
+    line << "; elapsed " << format_duration(elapsed);
+    if (ended < all && computed_runs > 0)
+      line << ", ETA " << format_duration(elapsed / static_cast<double>(computed_runs) * static_cast<double>(all - ended));
     bar.message(line.str());
-    bar.update(done);
+    bar.update(ended);
   };
-  const std::string out = a.out.empty() ? "results/compare-" + timestamp() : a.out;
-  const OutputDirLock lock(out);  // one run per output directory (created here)
   const opt::ComparisonResult result = opt::run_comparison(setup);
   bar.finish();
+  std::cerr << "compare: " << computed_evaluations << " evaluations computed, " << archived_evaluations
+            << " answered from the archive (" << setup.archive_directory << ")\n";
 
   const opt::WrittenFiles files = opt::write_comparison(result, out);
 
@@ -190,6 +216,8 @@ int run_compare(const CompareArgs& a) {
                            {"evaluations", r.result.evaluations},
                            {"evaluations_to_tau", r.evaluations_to_solve},
                            {"samples", r.result.samples},
+                           {"archive_hits", r.result.archive_hits},
+                           {"computed_evaluations", r.result.evaluations - r.result.archive_hits},
                            {"validated_objective", r.validation ? number(r.validation->objective) : nlohmann::json()},
                            {"validated_feasible", r.validation ? nlohmann::json(r.validation_feasible) : nlohmann::json()},
                            {"wall_time_s", r.result.wall_time_s}});
@@ -221,9 +249,12 @@ void register_compare(CLI::App& app) {
       "Compare optimisers (NLopt algorithms, IPOPT, SAO) on benchmark problems from several starts, each\n"
       "with an evaluation budget: a table (solved runs, evaluations to reach tau, best value, feasibility,\n"
       "time), convergence curves, data profiles and performance profiles (CSV, and PNG + PDF with gnuplot).\n"
+      "Every evaluation is archived in OUT/archive/: rerunning the same command with the same --out after\n"
+      "an interruption resumes (stored evaluations are answered from the archive, bit for bit).\n"
       "Exit status: 0 ok, 2 bad input.");
   sub->add_option("config", args->config, "YAML config (tau, problems, solvers; see configs/compare/)")->required();
-  sub->add_option("--out", args->out, "output directory (default results/compare-<timestamp>/)");
+  sub->add_option("--out", args->out,
+                  "output directory (default results/compare-<timestamp>/); give it to resume a comparison");
   sub->add_flag("--json", args->json, "print one JSON object (runs and files) instead of the table");
   sub->add_flag("--progress", args->progress, "show runs done, rate and ETA on stderr also when it is not a terminal");
   sub->callback([args] { set_exit_code(run_compare(*args)); });

@@ -191,31 +191,14 @@ ErkStepper::Status ErkStepper::step() {
     const double a = g0_[k], b = bg_[k];
     if (a == 0.0 || !((a < 0) != (b < 0) || b == 0.0)) continue;
     // Illinois on the Hermite interpolant.
-    double ta = tprev_, tb = bt_[k], ga = a, gb = b;
-    int side = 0;
-    for (int it = 0; it < 60 && std::fabs(tb - ta) > 1e-14 * std::max(1.0, std::fabs(t_)); ++it) {
-      const double tc = (gb != ga) ? tb - gb * (tb - ta) / (gb - ga) : 0.5 * (ta + tb);
+    auto g = [&](double tc) {
       dense(tc, tmp_.data());
       g_(tc, tmp_.data(), gtmp_.data(), user_);
       ++ctr_.root_evaluations;
-      const double gc = gtmp_[k];
-      if (gc == 0.0) {
-        ta = tb = tc;
-        break;
-      }
-      if ((gc < 0) == (gb < 0)) {
-        tb = tc;
-        gb = gc;
-        if (side == -1) ga *= 0.5;
-        side = -1;
-      } else {
-        ta = tc;
-        ga = gc;
-        if (side == 1) gb *= 0.5;
-        side = 1;
-      }
-    }
-    const double tk = tb;  // on the far side of the crossing
+      return gtmp_[k];
+    };
+    const double tol = 1e-14 * std::max(1.0, std::fabs(t_));
+    const double tk = illinois_crossing(g, tprev_, a, bt_[k], b, [tol](double) { return tol; }, 60, false);  // far side
     hint_[k] = tk;
     if (tk < troot) {
       troot = tk;

@@ -5,6 +5,36 @@
 
 namespace abuopt::detail {
 
+// Illinois (regula falsi, halving the value kept at an end that stays twice) on g over [ta, tb],
+// g(ta) = ga and g(tb) = gb of opposite signs, until the bracket is no wider than tol(tb) or after
+// max_iterations. Returns an exact zero found on the way, else tb: a time on tb's side of the
+// crossing (where g has gb's sign). A secant point that rounds onto an end is replaced by the
+// midpoint if `midpoint_at_ends` (the stepper's interpolant search keeps it: its roots, and with
+// them every run's numbers, stay as they were).
+template <class G, class Tol>
+double illinois_crossing(G&& g, double ta, double ga, double tb, double gb, Tol&& tol, int max_iterations,
+                         bool midpoint_at_ends = true) {
+  int side = 0;
+  for (int it = 0; it < max_iterations && std::fabs(tb - ta) > tol(tb); ++it) {
+    double tc = (gb != ga) ? tb - gb * (tb - ta) / (gb - ga) : 0.5 * (ta + tb);
+    if (midpoint_at_ends && !(tc > ta && tc < tb)) tc = 0.5 * (ta + tb);
+    const double gc = g(tc);
+    if (gc == 0.0) return tc;
+    if ((gc < 0) == (gb < 0)) {
+      tb = tc;
+      gb = gc;
+      if (side == -1) ga *= 0.5;
+      side = -1;
+    } else {
+      ta = tc;
+      ga = gc;
+      if (side == 1) gb *= 0.5;
+      side = 1;
+    }
+  }
+  return tb;
+}
+
 // g(ta) = ga and g(tb) = gb have opposite signs (or gb == 0). Returns a time on tb's side of the
 // crossing (where g has gb's sign or is zero), within tol of the crossing.
 //

@@ -123,9 +123,25 @@ void roots_contact(double tbar, const double* y, double* g, void* user);
 void root_rates_contact(double tbar, const double* y, double* gd, void* user);
 void set_contact_root_offsets(RunState& rs, double tbar, const double* y);
 // Chooses clusters and modes at an instant: balls at zero relative speed and zero gap may form or
-// leave clusters, clusters at zero speed may stick or slip. forced[g] != 0: cluster g of the
-// current clustering was stuck and one of its margins crossed zero (it must not stay stuck whole).
-void choose_contact_modes(RunState& rs, double W, double Wp, std::vector<double>& y, const std::vector<char>& forced);
+// leave clusters, clusters at zero speed may stick or slip. forced[i] != 0: the cluster of ball i
+// was stuck and one of its margins crossed zero (it must not stay stuck whole), forward
+// (kForcedForward: a block slips forward) and/or backward (kForcedBackward).
+constexpr char kForcedForward = 1, kForcedBackward = 2;
+// Method: Auto pivots (docs/model.md 11.8) and enumerates every joint option when pivoting finds
+// no consistent choice; Pivot and Enumerate (the reference) only for tests; Compare is Auto that
+// also enumerates on a copy and counts the choices that differ (sim_counters().mode_differs).
+enum class ContactChoiceMethod { Auto, Pivot, Enumerate, Compare };
+struct ContactChoiceResult {
+  bool consistent = false;  // the choice meets every condition of 11.5
+  int pivots = 0;           // flips of the active set
+  bool enumerated = false;  // Auto: pivoting failed and the enumeration chose
+};
+// The method of the simulator's runs on this thread (Auto; tests and benchmarks compare it with
+// Enumerate, the choice before pivoting).
+ContactChoiceMethod& run_contact_choice();
+ContactChoiceResult choose_contact_modes(RunState& rs, double W, double Wp, std::vector<double>& y,
+                                         const std::vector<char>& forced,
+                                         ContactChoiceMethod method = run_contact_choice());
 // Applies the roots found at an event: impacts for closing gaps, zero speed for clusters that
 // stopped; then choose_contact_modes. Returns the number of impacts.
 int handle_contact_event(RunState& rs, double tbar, std::vector<double>& y, const std::vector<int>& rinfo);

@@ -8,6 +8,8 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "root_refine.hpp"
+
 namespace abuopt::detail {
 
 namespace {
@@ -277,27 +279,13 @@ void StuckPropagator::state_at(double t0, const cplx a0[2], double t, double* y)
 // Illinois on the exact solution (the stepper's polished roots, docs/model.md 11.5).
 double StuckPropagator::locate(std::size_t k, double ta, double ga, double tb, double gb, const cplx a0[2], double t0) {
   std::vector<double> yc(ywork_);
-  int side = 0;
-  for (int it = 0; it < 100 && std::fabs(tb - ta) > 4e-16 * std::max(1.0, std::fabs(tb)); ++it) {
-    double tc = (gb != ga) ? tb - gb * (tb - ta) / (gb - ga) : 0.5 * (ta + tb);
-    if (!(tc > ta && tc < tb)) tc = 0.5 * (ta + tb);
+  auto g = [&](double tc) {
     state_at(t0, a0, tc, yc.data());
     g_(tc, yc.data(), gtmp_.data(), &rs_);
-    const double gc = gtmp_[k];
-    if (gc == 0.0) return tc;
-    if ((gc < 0) == (gb < 0)) {
-      tb = tc;
-      gb = gc;
-      if (side == -1) ga *= 0.5;
-      side = -1;
-    } else {
-      ta = tc;
-      ga = gc;
-      if (side == 1) gb *= 0.5;
-      side = 1;
-    }
-  }
-  return tb;  // on the far side of the crossing
+    return gtmp_[k];
+  };
+  auto tol = [](double tbk) { return 4e-16 * std::max(1.0, std::fabs(tbk)); };
+  return illinois_crossing(g, ta, ga, tb, gb, tol, 100);  // on the far side of the crossing
 }
 
 // roots_plain with every ball stuck, at a grid point (W, W' from the table, not the profile), from

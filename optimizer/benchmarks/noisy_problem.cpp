@@ -16,6 +16,19 @@ std::uint64_t splitmix64(std::uint64_t z) {
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
   return z ^ (z >> 31);
 }
+
+// The noise of both forms: v + amplitude (1 + |v|) u(k) on the objective (k = 0), then the
+// inequality and the equality constraints (k = 1, 2, ...); the objective's noise-free value is kept
+// as the metric noise_free_objective.
+template <class UnitNoise>
+void add_relative_noise(opt::Evaluation& e, double amplitude, const UnitNoise& u) {
+  auto noisy = [&](double v, std::uint64_t k) { return v + amplitude * (1.0 + std::fabs(v)) * u(k); };
+  e.metrics["noise_free_objective"] = e.objective;
+  e.objective = noisy(e.objective, 0);
+  std::uint64_t k = 1;
+  for (double& g : e.inequality) g = noisy(g, k++);
+  for (double& h : e.equality) h = noisy(h, k++);
+}
 }  // namespace
 
 NoisyProblem::NoisyProblem(std::unique_ptr<opt::Problem> inner, double amplitude, std::uint64_t seed,
@@ -41,12 +54,7 @@ opt::Evaluation NoisyProblem::evaluate(const std::vector<double>& x) {
   if (samples_ > 0) return evaluate_sampled(x, samples_);
   opt::Evaluation e = inner_->evaluate(x);
   if (!e.ok || amplitude_ == 0.0) return e;
-  auto noisy = [&](double v, std::uint64_t k) { return v + amplitude_ * (1.0 + std::fabs(v)) * unit_noise(x, seed_, k); };
-  e.metrics["noise_free_objective"] = e.objective;
-  e.objective = noisy(e.objective, 0);
-  std::uint64_t k = 1;
-  for (double& g : e.inequality) g = noisy(g, k++);
-  for (double& h : e.equality) h = noisy(h, k++);
+  add_relative_noise(e, amplitude_, [&](std::uint64_t k) { return unit_noise(x, seed_, k); });
   return e;
 }
 
@@ -64,12 +72,7 @@ opt::Evaluation NoisyProblem::evaluate_sampled(const std::vector<double>& x, std
     for (std::size_t i = 0; i < n; ++i) sum += unit_noise(x, splitmix64(seed_ ^ splitmix64(0xC0FFEEULL + i)), k);
     return std::sqrt(3.0) * sum / static_cast<double>(n);
   };
-  auto noisy = [&](double v, std::uint64_t k) { return v + amplitude_ * (1.0 + std::fabs(v)) * mean_noise(k); };
-  e.metrics["noise_free_objective"] = e.objective;
-  e.objective = noisy(e.objective, 0);
-  std::uint64_t k = 1;
-  for (double& g : e.inequality) g = noisy(g, k++);
-  for (double& h : e.equality) h = noisy(h, k++);
+  add_relative_noise(e, amplitude_, mean_noise);
   return e;
 }
 

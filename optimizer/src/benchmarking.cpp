@@ -4,12 +4,14 @@
 #include "abuopt/optimizer/evaluation_scheduler.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <exception>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <map>
+#include <mutex>
 #include <random>
 #include <set>
 #include <sstream>
@@ -20,6 +22,7 @@
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/text.hpp"
 #include "abuopt/optimizer/algorithms.hpp"
+#include "abuopt/optimizer/evaluation_archive.hpp"
 #include "abuopt/optimizer/minimize.hpp"
 #include "abuopt/optimizer/two_stage.hpp"
 
@@ -104,10 +107,18 @@ std::vector<std::vector<double>> starting_points(const Problem& problem, int sta
   return out;
 }
 
-long evaluations_to_solve(const OptimizationResult& result, double f_star, double tau, const std::string& metric) {
+bool counts_as_problem_value(const EvaluationRecord& h, std::size_t full_sample_size, const std::string& metric) {
+  if (full_sample_size == 0 || (!metric.empty() && h.metrics.count(metric))) return true;
+  const auto runs = h.metrics.find("runs");
+  return runs == h.metrics.end() || runs->second >= static_cast<double>(full_sample_size);
+}
+
+long evaluations_to_solve(const OptimizationResult& result, double f_star, double tau, const std::string& metric,
+                          std::size_t full_sample_size) {
   const double threshold = solved_threshold(f_star, tau);
   for (const EvaluationRecord& h : result.history)
-    if (h.feasible && true_objective(h, metric) - f_star <= threshold) return h.index + 1;
+    if (h.feasible && counts_as_problem_value(h, full_sample_size, metric) && true_objective(h, metric) - f_star <= threshold)
+      return h.index + 1;
   return -1;
 }
 
@@ -193,6 +204,9 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
   ComparisonResult out;
   out.tau = setup.tau;
   for (const SolverSpec& s : setup.solvers) out.solvers.push_back(s.label);
+  std::size_t total_runs = 0, ended = 0;
+  for (const ProblemSpec& p : setup.problems) total_runs += static_cast<std::size_t>(p.starts) * setup.solvers.size();
+  std::mutex ended_mutex;
   for (const ProblemSpec& spec : setup.problems) {
     out.problems.push_back(spec.label);
     std::unique_ptr<Problem> probe = spec.make();
@@ -202,17 +216,40 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
     // and lands in its own slot, so the results do not depend on how many run at once
     const std::size_t tasks = static_cast<std::size_t>(spec.starts) * setup.solvers.size();
     out.runs.resize(first_run + tasks);
+    // resumable: one archive per run, and one of the validations of this problem
+    const bool archived = !setup.archive_directory.empty();
+    const std::string identity = spec.identity.empty() ? spec.label : spec.identity;
+    const std::filesystem::path archive_dir = std::filesystem::path(setup.archive_directory) / file_safe(spec.label);
+    std::unique_ptr<EvaluationArchive> validation_archive;
+    if (archived) {
+      std::error_code ec;
+      std::filesystem::create_directories(archive_dir, ec);
+      if (ec) throw ConfigError("archive directory '" + archive_dir.string() + "' cannot be created: " + ec.message());
+      if (spec.validate)
+        validation_archive =
+            std::make_unique<EvaluationArchive>((archive_dir / "validation.sqlite").string(), identity + "/validation");
+    }
     auto run_task = [&](std::size_t t) {
       const int k = static_cast<int>(t / setup.solvers.size());
       const SolverSpec& solver = setup.solvers[t % setup.solvers.size()];
       {
-        std::unique_ptr<Problem> problem = spec.make();
+        std::unique_ptr<Problem> fresh = spec.make();
+        std::unique_ptr<EvaluationArchive> archive;
+        std::unique_ptr<ArchivedProblem> archived_problem;
+        if (archived) {
+          const std::string file = "start" + std::to_string(k) + "-" + file_safe(solver.label) + ".sqlite";
+          archive = std::make_unique<EvaluationArchive>((archive_dir / file).string(), identity);
+          archived_problem = std::make_unique<ArchivedProblem>(*fresh, *archive);
+        }
+        Problem* problem = archived ? static_cast<Problem*>(archived_problem.get()) : fresh.get();
         OptimizerOptions o = solver.options;
         o.max_evaluations = spec.max_evaluations;
         o.constraint_tolerance = spec.constraint_tolerance;
         o.seed = spec.seed + static_cast<unsigned long>(k);
         o.keep_history = true;
-        o.handle_sigint = o.handle_sigint && setup.threads <= 1;  // one handler owner at a time
+        // one handler owner at a time; with archives Ctrl-C ends the whole comparison (what is
+        // stored stays), not one run that the comparison would then record as finished
+        o.handle_sigint = o.handle_sigint && setup.threads <= 1 && !archived;
         // runs already go at once: their evaluations go one at a time unless the solver says otherwise
         if (setup.threads > 1 && o.evaluation_threads == 0) o.evaluation_threads = 1;
         RunRecord rec;
@@ -220,6 +257,7 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
         rec.solver = solver.label;
         rec.start = k;
         rec.dimension = problem->dimension();
+        rec.sample_size = problem->sample_size();
         rec.x0 = starts[k];
         try {
           if (solver.then) {
@@ -245,7 +283,7 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
         }
         double best = kInf;
         for (const EvaluationRecord& h : rec.result.history) {
-          if (!h.feasible) continue;
+          if (!h.feasible || !counts_as_problem_value(h, rec.sample_size, setup.true_objective_metric)) continue;
           const double f = true_objective(h, setup.true_objective_metric);
           if (f < best) {
             best = f;
@@ -255,14 +293,27 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
         rec.best_true_objective = best;
         rec.feasible = std::isfinite(best);
         if (spec.validate && !rec.result.x.empty()) {
-          try {
-            rec.validation = spec.validate(rec.result.x);
-          } catch (const std::exception& e) {
-            rec.validation = Evaluation::failed(std::string("validation threw: ") + e.what());
+          if (validation_archive) rec.validation = validation_archive->find(rec.result.x);
+          rec.validation_from_archive = rec.validation.has_value();
+          if (!rec.validation) {
+            const auto started = std::chrono::steady_clock::now();
+            try {
+              rec.validation = spec.validate(rec.result.x);
+              if (validation_archive)
+                validation_archive->store(
+                    rec.result.x, *rec.validation,
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+            } catch (const std::exception& e) {
+              rec.validation = Evaluation::failed(std::string("validation threw: ") + e.what());
+            }
           }
           rec.validation_feasible = is_feasible(*rec.validation, spec.constraint_tolerance);
         }
         out.runs[first_run + t] = std::move(rec);
+      }
+      if (setup.on_run_ended) {
+        const std::lock_guard<std::mutex> lock(ended_mutex);
+        setup.on_run_ended(out.runs[first_run + t], ++ended, total_runs);
       }
     };
     // the runs are one batch of independent tasks on the evaluation scheduler's threads
@@ -285,7 +336,9 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
     for (std::size_t i = first_run; i < out.runs.size(); ++i) {
       RunRecord& rec = out.runs[i];
       rec.evaluations_to_solve =
-          std::isfinite(f_star) ? evaluations_to_solve(rec.result, f_star, setup.tau, setup.true_objective_metric) : -1;
+          std::isfinite(f_star) ? evaluations_to_solve(rec.result, f_star, setup.tau, setup.true_objective_metric,
+                                                      rec.sample_size)
+                               : -1;
       if (setup.on_run) setup.on_run(rec);
     }
   }

@@ -39,6 +39,17 @@ void require(bool ok, const std::string& prefix, const std::string& key, double 
   if (!ok) throw ConfigError(prefix + "." + key, format_number(value), rule);
 }
 
+// A finite value in an interval; `interval` is one of "[]", "(]", "()", "[)" (closed or open at
+// each end). The rule reads "must be in [lo, hi]" and then `note`, if any.
+void require_in(const std::string& prefix, const std::string& key, double value, const char* interval, double lo,
+                double hi, const std::string& note = "") {
+  const bool lo_ok = interval[0] == '[' ? value >= lo : value > lo;
+  const bool hi_ok = interval[1] == ']' ? value <= hi : value < hi;
+  require(std::isfinite(value) && lo_ok && hi_ok, prefix, key, value,
+          std::string("must be in ") + interval[0] + format_number(lo) + ", " + format_number(hi) + interval[1] +
+              (note.empty() ? "" : " " + note));
+}
+
 }  // namespace
 
 const std::vector<std::string>& surrogate_kind_names() {
@@ -79,34 +90,24 @@ SubproblemSolver subproblem_solver_from_string(const std::string& text, const st
 
 void SaoOptions::validate(const std::string& p) const {
   require(doe_points >= 0, p, "doe_points", doe_points, "must be >= 0 (0: automatic)");
-  require(std::isfinite(doe_points_factor) && doe_points_factor >= 1 && doe_points_factor <= 10, p,
-          "doe_points_factor", doe_points_factor, "must be in [1, 10]");
-  require(std::isfinite(reuse_distance) && reuse_distance > 0 && reuse_distance <= 1, p, "reuse_distance",
-          reuse_distance, "must be in (0, 1]");
-  require(std::isfinite(neighbourhood) && neighbourhood >= 1 && neighbourhood <= 10, p, "neighbourhood",
-          neighbourhood, "must be in [1, 10]");
-  require(std::isfinite(geometry_spread) && geometry_spread > 0 && geometry_spread < 1, p, "geometry_spread",
-          geometry_spread, "must be in (0, 1)");
-  require(std::isfinite(initial_radius) && initial_radius > 0 && initial_radius <= 1, p, "initial_radius",
-          initial_radius, "must be in (0, 1]");
+  require_in(p, "doe_points_factor", doe_points_factor, "[]", 1, 10);
+  require_in(p, "reuse_distance", reuse_distance, "(]", 0, 1);
+  require_in(p, "neighbourhood", neighbourhood, "[]", 1, 10);
+  require_in(p, "geometry_spread", geometry_spread, "()", 0, 1);
+  require_in(p, "initial_radius", initial_radius, "(]", 0, 1);
   require(std::isfinite(min_radius) && min_radius > 0 && min_radius <= initial_radius, p, "min_radius", min_radius,
           "must be in (0, initial_radius = " + format_number(initial_radius) + "]");
   require(std::isfinite(max_radius) && max_radius >= initial_radius && max_radius <= 1, p, "max_radius", max_radius,
           "must be in [initial_radius = " + format_number(initial_radius) + ", 1]");
-  require(std::isfinite(shrink_factor) && shrink_factor > 0 && shrink_factor < 1, p, "shrink_factor", shrink_factor,
-          "must be in (0, 1)");
-  require(std::isfinite(expand_factor) && expand_factor >= 1 && expand_factor <= 100, p, "expand_factor",
-          expand_factor, "must be in [1, 100]");
-  require(std::isfinite(rho_shrink) && rho_shrink >= 0 && rho_shrink < 1, p, "rho_shrink", rho_shrink,
-          "must be in [0, 1)");
+  require_in(p, "shrink_factor", shrink_factor, "()", 0, 1);
+  require_in(p, "expand_factor", expand_factor, "[]", 1, 100);
+  require_in(p, "rho_shrink", rho_shrink, "[)", 0, 1);
   require(std::isfinite(rho_expand_low) && rho_expand_low > rho_shrink, p, "rho_expand_low", rho_expand_low,
           "must be > rho_shrink = " + format_number(rho_shrink));
   require(std::isfinite(rho_expand_high) && rho_expand_high >= rho_expand_low, p, "rho_expand_high",
           rho_expand_high, "must be >= rho_expand_low = " + format_number(rho_expand_low));
-  require(std::isfinite(short_step) && short_step >= 0 && short_step < 1, p, "short_step", short_step,
-          "must be in [0, 1) (0: off)");
-  require(std::isfinite(noise_tolerance) && noise_tolerance >= 0 && noise_tolerance <= 100, p, "noise_tolerance",
-          noise_tolerance, "must be in [0, 100] (0: off)");
+  require_in(p, "short_step", short_step, "[)", 0, 1, "(0: off)");
+  require_in(p, "noise_tolerance", noise_tolerance, "[]", 0, 100, "(0: off)");
   require(std::isfinite(penalty_initial) && penalty_initial >= 0, p, "penalty_initial", penalty_initial,
           "must be >= 0 (0: automatic)");
   require(std::isfinite(penalty_multiplier_factor) && penalty_multiplier_factor >= 1, p, "penalty_multiplier_factor",
@@ -116,8 +117,7 @@ void SaoOptions::validate(const std::string& p) const {
           "must be >= 0");
   require(subproblem_max_evaluations >= 10, p, "subproblem_max_evaluations", subproblem_max_evaluations,
           "must be >= 10");
-  require(std::isfinite(kriging_nugget) && kriging_nugget > 0 && kriging_nugget < 1, p, "kriging_nugget",
-          kriging_nugget, "must be in (0, 1)");
+  require_in(p, "kriging_nugget", kriging_nugget, "()", 0, 1);
   require(global_phase.points == 0 || global_phase.points >= 2, p + ".global_phase", "points", global_phase.points,
           "must be 0 (no global phase) or >= 2");
   require(global_phase.iterations == 0 || global_phase.points > 0, p + ".global_phase", "iterations",
@@ -127,8 +127,7 @@ void SaoOptions::validate(const std::string& p) const {
           samples.max,
           samples.initial > 0 ? "must be 0 (the problem's largest) or >= samples.initial = " + std::to_string(samples.initial)
                               : std::string("needs samples.initial >= 1 (the schedule is off)"));
-  require(std::isfinite(samples.exponent) && samples.exponent >= 0 && samples.exponent <= 8, p + ".samples",
-          "exponent", samples.exponent, "must be in [0, 8]");
+  require_in(p + ".samples", "exponent", samples.exponent, "[]", 0, 8);
   if (surrogate == SurrogateKind::Quadratic && doe == DoeKind::Koshal)
     throw ConfigError(p + ".doe", to_string(doe), "koshal (n+1 points) cannot determine a quadratic surrogate; use auto, axial, "
                                        "central_composite or lhs");

@@ -5,10 +5,12 @@
 #include <unistd.h>
 
 #include <array>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -121,4 +123,131 @@ TEST(CompareCli, BadConfigIsOneMessageWithExitStatus2) {
   const Result missing = run("compare " + kConfigs + "compare/no_such.yaml");
   EXPECT_EQ(missing.status, 2) << missing.err;
   EXPECT_NE(missing.err.find("no_such.yaml"), std::string::npos) << missing.err;
+}
+
+namespace {
+
+// runs.csv without its wall_time_s column (the only field a resumed comparison may change).
+std::string runs_without_times(const std::string& dir) {
+  std::ifstream f(fs::path(dir) / "runs.csv");
+  std::string out, line;
+  int column = -1;
+  while (std::getline(f, line)) {
+    std::vector<std::string> fields;
+    std::string field;
+    bool quoted = false;
+    for (char c : line) {
+      if (c == '"') quoted = !quoted;
+      if (c == ',' && !quoted) {
+        fields.push_back(field);
+        field.clear();
+      } else {
+        field += c;
+      }
+    }
+    fields.push_back(field);
+    if (column < 0)
+      for (std::size_t i = 0; i < fields.size(); ++i)
+        if (fields[i] == "wall_time_s") column = static_cast<int>(i);
+    for (std::size_t i = 0; i < fields.size(); ++i)
+      if (static_cast<int>(i) != column) out += fields[i] + "|";
+    out += "\n";
+  }
+  return out;
+}
+
+long json_sum(const nlohmann::json& j, const char* key) {
+  long s = 0;
+  for (const auto& r : j["runs"]) s += r[key].get<long>();
+  return s;
+}
+
+}  // namespace
+
+// The resumable comparison (issue 9): a small startup-profile comparison (16 Monte Carlo runs per
+// evaluation, 2 starts x 2 solvers, one run at a time) killed with SIGKILL once its first run has
+// ended and a second is under way, then rerun with the same --out: the same runs.csv (wall times
+// aside) as an uninterrupted comparison, the first run answered wholly from its archive and the
+// rerun computing fewer evaluations than the uninterrupted one.
+TEST(CompareCli, KilledComparisonResumesFromItsArchives) {
+  const std::string cfg = write_config(
+      "compare_resume.yaml",
+      "problems:\n"
+      "  - label: startup\n"
+      "    max_evaluations: 14\n"
+      "    starts: 2\n"
+      "    seed: 3\n"
+      "    startup_profile:\n"
+      "      abu: {friction_mu: 0.02}\n"
+      "      profile:\n"
+      "        start_frequency_hz: 0\n"
+      "        segments:\n"
+      "          - {end_frequency_hz: 25.0, duration_s: 1.0}\n"
+      "          - {end_frequency_hz: 29.5, duration_s: 10.0}\n"
+      "          - {end_frequency_hz: 100.0, duration_s: 8.0}\n"
+      "      motor: {kind: ideal}\n"
+      "      simulation: {method: event_driven, rtol: 1.0e-6}\n"
+      "      montecarlo: {design: sobol, runs: 16, seed: 11, threads: 1}\n"
+      "      validation: {runs: 32, seed: 5}\n"
+      "      design:\n"
+      "        segments:\n"
+      "          - end_frequency_hz: {min: 15, max: 28, x0: 25}\n"
+      "            duration_s: {min: 0.3, max: 3, x0: 1}\n"
+      "          - end_frequency_hz: {min: 28, max: 32, x0: 29.5}\n"
+      "            duration_s: {min: 1, max: 12, x0: 10}\n"
+      "          - end_frequency_hz: 100\n"
+      "            duration_s: {min: 1, max: 10, x0: 8}\n"
+      "      objective: {kind: mean, definition: magnitude}\n"
+      "      constraints: {max_startup_time_s: 20, max_pct_mi: 20, max_amplitude_mm: 0.55, amplitude: max}\n"
+      "threads: 1\n"
+      "solvers:\n"
+      "  - {label: SAO, algorithm: sao, sao: {initial_radius: 0.2, samples: {initial: 8, max: 16}}}\n"
+      "  - {label: COBYLA, algorithm: cobyla}\n");
+  const std::string whole = fresh_dir("compare_resume_whole");
+  const Result plain = run("compare " + cfg + " --json --out " + whole);
+  ASSERT_EQ(plain.status, 0) << plain.out << plain.err;
+  const auto jp = nlohmann::json::parse(plain.out);
+  ASSERT_EQ(jp["runs"].size(), 4u);
+  EXPECT_EQ(json_sum(jp, "archive_hits"), 0);
+  // one progress line per run, with the time so far and an ETA until the last
+  EXPECT_NE(plain.err.find("[1/4] startup start 0 SAO: "), std::string::npos) << plain.err;
+  EXPECT_NE(plain.err.find(", ETA "), std::string::npos) << plain.err;
+  EXPECT_NE(plain.err.find("[4/4] startup start 1 COBYLA: "), std::string::npos) << plain.err;
+
+  // the same comparison, killed (SIGKILL: nothing of its own gets to run) after its first run
+  const std::string out = fresh_dir("compare_resume_killed");
+  const std::string err_file = out + ".stderr";
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    if (!freopen(err_file.c_str(), "w", stderr) || !freopen("/dev/null", "w", stdout)) _exit(127);
+    execl(ABUOPT_EXE, ABUOPT_EXE, "compare", cfg.c_str(), "--out", out.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  bool first_ended = false;
+  for (int i = 0; i < 6000 && !first_ended; ++i) {  // at most 60 s
+    std::ifstream f(err_file);
+    const std::string err((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    first_ended = err.find("[1/4]") != std::string::npos;
+    if (!first_ended) usleep(10000);
+  }
+  kill(pid, SIGKILL);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(first_ended) << "the first run did not end within 60 s";
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the comparison ended before it was killed; make it longer";
+  EXPECT_FALSE(fs::exists(fs::path(out) / "runs.csv"));
+
+  const Result resumed = run("compare " + cfg + " --json --out " + out);
+  ASSERT_EQ(resumed.status, 0) << resumed.out << resumed.err;
+  const auto jr = nlohmann::json::parse(resumed.out);
+  ASSERT_EQ(jr["runs"].size(), 4u);
+  EXPECT_EQ(runs_without_times(out), runs_without_times(whole));
+  // the finished first run replayed from its archive; the whole rerun computed less
+  EXPECT_EQ(jr["runs"][0]["archive_hits"], jr["runs"][0]["evaluations"]);
+  EXPECT_EQ(jr["runs"][0]["computed_evaluations"], 0);
+  EXPECT_LT(json_sum(jr, "computed_evaluations"), json_sum(jp, "computed_evaluations"));
+  EXPECT_EQ(json_sum(jr, "evaluations"), json_sum(jp, "evaluations"));
+  EXPECT_NE(resumed.err.find("answered from the archive"), std::string::npos) << resumed.err;
+  fs::remove(err_file);
 }

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "abuopt/core/ball_contact.hpp"
@@ -33,9 +34,9 @@ TEST(BallContactLong, NoFinalStateOverlapsIn1024RandomStartsThreeSeeds) {
 // Issue 14: four balls, the exact all-stuck propagator (the default) against the Runge-Kutta
 // path, 1024 random starts (seed 202, the start that once ended with a 3.6e-7 rad overlap:
 // a gap that closed and opened again inside one Runge-Kutta step, docs/stuck_propagator.md 5).
-// No final state overlaps on either path. Runs that end at the chatter limit are counted
-// outcomes (10 of 1024 on both paths when measured: a chatter of the contact event handling, the
-// same with either stuck integrator; docs/performance.md): at most 2 %.
+// No final state overlaps on either path, and no run ends at the chatter limit (10 of 1024 on both
+// paths before forced blocks were released only in the direction whose margin crossed,
+// docs/model.md 11.8; 0 since).
 TEST(BallContactLong, NoFinalStateOverlapsIn1024RandomStartsFourBallsBothStuckIntegrators) {
   for (StuckIntegrator stuck : {StuckIntegrator::Exact, StuckIntegrator::RungeKutta}) {
     SimulationSetup s;
@@ -54,7 +55,9 @@ TEST(BallContactLong, NoFinalStateOverlapsIn1024RandomStartsFourBallsBothStuckIn
       }
       overlaps += min_contact_clearance(s.abu, o.beta_final) < -1e-12;
     }
+    std::printf("four balls, %s stuck integrator: %d of 1024 runs failed, %d overlaps\n", to_string(stuck).c_str(),
+                failed, overlaps);
     EXPECT_EQ(overlaps, 0) << to_string(stuck);
-    EXPECT_LE(failed, 20) << to_string(stuck);
+    EXPECT_EQ(failed, 0) << to_string(stuck);
   }
 }

@@ -2,6 +2,7 @@
 // case, the "solved" test, and a small end-to-end comparison with its files.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -78,6 +79,33 @@ TEST(Profiles, EvaluationsToSolve) {
   h.feasible = true;
   z.history.push_back(h);
   EXPECT_EQ(opt::evaluations_to_solve(z, 0.0, 0.01), 1);
+}
+
+// A sampled problem (own size 256): a value on 64 runs (adaptive sample size) does not count as a
+// value of the problem unless it carries the noise-free metric; at 256 runs, or without a `runs`
+// metric, or for a problem that is not sampled, it does.
+TEST(Profiles, ValuesOnFewerRunsDoNotCount) {
+  opt::OptimizationResult r;
+  auto add = [&](double f, double runs) {
+    opt::EvaluationRecord h;
+    h.index = static_cast<long>(r.history.size());
+    h.objective = f;
+    h.feasible = true;
+    h.metrics["runs"] = runs;
+    r.history.push_back(h);
+  };
+  add(10.05, 64);   // 1: within 1 % of 10, but on 64 runs
+  add(10.5, 256);   // 2: on 256 runs, not within
+  add(10.08, 256);  // 3: within, on 256 runs
+  EXPECT_EQ(opt::evaluations_to_solve(r, 10.0, 0.01, "noise_free_objective", 256), 3);
+  EXPECT_EQ(opt::evaluations_to_solve(r, 10.0, 0.01, "noise_free_objective", 0), 1);   // not sampled
+  EXPECT_EQ(opt::evaluations_to_solve(r, 10.0, 0.01, "noise_free_objective", 64), 1);  // own size 64
+  r.history[0].metrics["noise_free_objective"] = 10.05;  // a noise-free value counts at any size
+  EXPECT_TRUE(opt::counts_as_problem_value(r.history[0], 256, "noise_free_objective"));
+  EXPECT_EQ(opt::evaluations_to_solve(r, 10.0, 0.01, "noise_free_objective", 256), 1);
+  r.history[1].metrics.erase("runs");
+  EXPECT_TRUE(opt::counts_as_problem_value(r.history[1], 256, "noise_free_objective"));
+  EXPECT_FALSE(opt::counts_as_problem_value(r.history[0], 256, ""));
 }
 
 TEST(Profiles, SolveMatrixFromRuns) {
@@ -234,6 +262,14 @@ TEST(Comparison, ReadSolverSpec) {
 
 }  // namespace
 
+// hs071 with the sampled noise: one run's relative noise 0.01, at most 32 runs.
+std::unique_ptr<opt::Problem> sampled_noisy_hs071() {
+  opt::benchmarks::BenchmarkSettings s;
+  s.noise_amplitude = 0.01;
+  s.noise_samples = 32;
+  return opt::benchmarks::make_benchmark("noisy_hs071", s);
+}
+
 // Out-of-sample validation and simulation counts: ProblemSpec::validate is called on every run's
 // result (here the noise-free hs071 at the result of a run on its sampled noisy variant), and
 // runs.csv carries samples, validated_objective, validated_max_violation and validated_feasible.
@@ -241,12 +277,7 @@ TEST(Comparison, ValidatesEveryResultAndCountsSimulations) {
   opt::ComparisonSetup setup;
   opt::ProblemSpec spec;
   spec.label = "sampled_hs071";
-  spec.make = [] {
-    opt::benchmarks::BenchmarkSettings s;
-    s.noise_amplitude = 0.01;
-    s.noise_samples = 32;
-    return opt::benchmarks::make_benchmark("noisy_hs071", s);
-  };
+  spec.make = sampled_noisy_hs071;
   spec.max_evaluations = 40;
   spec.starts = 2;
   spec.constraint_tolerance = 1e-2;
@@ -282,5 +313,95 @@ TEST(Comparison, ValidatesEveryResultAndCountsSimulations) {
                        opt::format_number(r.runs[0].validation->objective) + ","),
             std::string::npos)
       << first;
+  std::filesystem::remove_all(dir);
+}
+
+// Resumable comparisons (ComparisonSetup::archive_directory): a rerun on the archives of a finished
+// comparison computes nothing (every evaluation and validation answered from them) and gives the
+// same runs bit for bit; a comparison cut short (here: a smaller budget, which ends COBYLA on the
+// same path earlier) and then rerun with the full budget answers the stored evaluations and gives
+// exactly the runs of a comparison without archives.
+TEST(Comparison, ArchivesMakeAComparisonResumable) {
+  const std::string dir = std::string(ABUOPT_BINARY_DIR) + "/benchmarking_resume_archive";
+  std::filesystem::remove_all(dir);
+  std::atomic<int> validated{0};  // the runs go two at a time
+  auto setup_with = [&](long budget, const std::vector<std::string>& solvers, const std::string& archive) {
+    opt::ComparisonSetup setup;
+    opt::ProblemSpec spec;
+    spec.label = "sampled hs071";  // a space: the archive's file names are made safe
+    spec.identity = "noisy_hs071/a0.01/n32";
+    spec.make = sampled_noisy_hs071;
+    spec.max_evaluations = budget;
+    spec.starts = 2;
+    spec.seed = 4;
+    spec.constraint_tolerance = 1e-2;
+    spec.validate = [&validated](const std::vector<double>& x) {
+      ++validated;
+      return opt::benchmarks::make_benchmark("hs071")->evaluate(x);
+    };
+    setup.problems.push_back(spec);
+    for (const auto& s : solvers) setup.solvers.push_back(opt::solver_spec(s, s));
+    setup.threads = 2;
+    setup.archive_directory = archive;
+    return setup;
+  };
+  auto expect_same_runs = [](const opt::ComparisonResult& a, const opt::ComparisonResult& b) {
+    ASSERT_EQ(a.runs.size(), b.runs.size());
+    for (std::size_t i = 0; i < a.runs.size(); ++i) {
+      const auto& x = a.runs[i];
+      const auto& y = b.runs[i];
+      EXPECT_EQ(x.solver, y.solver);
+      EXPECT_EQ(x.start, y.start);
+      EXPECT_EQ(x.result.evaluations, y.result.evaluations) << i;
+      EXPECT_EQ(x.result.x, y.result.x) << i;
+      EXPECT_EQ(x.result.objective, y.result.objective) << i;
+      EXPECT_EQ(x.result.samples, y.result.samples) << i;
+      EXPECT_EQ(x.result.reason, y.result.reason) << i;
+      ASSERT_EQ(x.result.history.size(), y.result.history.size()) << i;
+      for (std::size_t k = 0; k < x.result.history.size(); ++k) {
+        EXPECT_EQ(x.result.history[k].x, y.result.history[k].x) << i << " " << k;
+        EXPECT_EQ(x.result.history[k].objective, y.result.history[k].objective) << i << " " << k;
+      }
+      EXPECT_EQ(x.best_true_objective, y.best_true_objective) << i;
+      EXPECT_EQ(x.evaluations_to_solve, y.evaluations_to_solve) << i;
+      ASSERT_EQ(x.validation.has_value(), y.validation.has_value()) << i;
+      if (x.validation) {
+        EXPECT_EQ(x.validation->objective, y.validation->objective) << i;
+      }
+    }
+  };
+
+  // a finished comparison replayed: nothing computed, the same runs
+  const std::vector<std::string> both = {"sao", "cobyla"};
+  const opt::ComparisonResult first = opt::run_comparison(setup_with(40, both, dir + "/a"));
+  EXPECT_EQ(validated, 4);
+  std::size_t ended = 0;
+  opt::ComparisonSetup again = setup_with(40, both, dir + "/a");
+  again.on_run_ended = [&ended](const opt::RunRecord&, std::size_t n, std::size_t total) {
+    EXPECT_EQ(n, ++ended);
+    EXPECT_EQ(total, 4u);
+  };
+  const opt::ComparisonResult replay = opt::run_comparison(again);
+  EXPECT_EQ(ended, 4u);
+  EXPECT_EQ(validated, 4);  // the validations came from the archive too
+  expect_same_runs(first, replay);
+  for (const auto& run : replay.runs) {
+    EXPECT_EQ(run.result.archive_hits, run.result.evaluations) << run.solver << " " << run.start;
+    EXPECT_TRUE(run.validation_from_archive);
+  }
+  for (const auto& run : first.runs) EXPECT_EQ(run.result.archive_hits, 0) << run.solver << " " << run.start;
+  EXPECT_TRUE(std::filesystem::exists(dir + "/a/sampled_hs071/start1-sao.sqlite"));
+  EXPECT_TRUE(std::filesystem::exists(dir + "/a/sampled_hs071/validation.sqlite"));
+
+  // cut short at 15 evaluations, then the full 40: the same runs as without any archive
+  const opt::ComparisonResult cut = opt::run_comparison(setup_with(15, {"cobyla"}, dir + "/b"));
+  const opt::ComparisonResult resumed = opt::run_comparison(setup_with(40, {"cobyla"}, dir + "/b"));
+  const opt::ComparisonResult plain = opt::run_comparison(setup_with(40, {"cobyla"}, ""));
+  expect_same_runs(plain, resumed);
+  for (std::size_t i = 0; i < resumed.runs.size(); ++i) {
+    EXPECT_EQ(cut.runs[i].result.evaluations, 15);
+    EXPECT_EQ(resumed.runs[i].result.archive_hits, 15) << i;  // the stored ones answered, the rest computed
+    EXPECT_GT(resumed.runs[i].result.evaluations, 15) << i;
+  }
   std::filesystem::remove_all(dir);
 }

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <iostream>
 #include <limits>
 #include <memory>
@@ -187,44 +188,30 @@ TEST(SaoSampling, ScheduleDoublesWhenNoiseHidesTheStep) {
 }
 
 TEST(SaoSampling, BadSettingsNameKeyValueAndRule) {
+  // each bad setting is one ConfigError whose message contains `text` (key, value and rule)
+  auto expect_error = [](const std::function<void()>& call, const std::string& text) {
+    try {
+      call();
+      ADD_FAILURE() << "no ConfigError; expected " << text;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+    }
+  };
   opt::SaoOptions s;
   s.samples.initial = -1;
-  try {
-    s.validate();
-    FAIL();
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("sao.samples.initial = -1"), std::string::npos) << e.what();
-  }
+  expect_error([&] { s.validate(); }, "sao.samples.initial = -1");
   s.samples.initial = 64;
   s.samples.max = 32;
-  try {
-    s.validate();
-    FAIL();
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("sao.samples.max = 32: must be 0"), std::string::npos) << e.what();
-  }
+  expect_error([&] { s.validate(); }, "sao.samples.max = 32: must be 0");
   // a problem whose size cannot be chosen, and one whose largest size is too small
   s.samples.max = 0;
   auto plain = opt::benchmarks::make_benchmark("noisy_hs071");
   opt::OptimizerOptions o;
   o.max_evaluations = 10;
-  try {
-    opt::minimize_sao(*plain, o, s);
-    FAIL();
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("sao.samples.initial = 64: needs a problem whose sample size"),
-              std::string::npos)
-        << e.what();
-  }
+  expect_error([&] { opt::minimize_sao(*plain, o, s); }, "sao.samples.initial = 64: needs a problem whose sample size");
   auto small = sampled("hs071", 0.1, 32);
-  try {
-    opt::minimize_sao(*small, o, s);
-    FAIL();
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("sao.samples.initial = 64: must be <= the problem's largest sample size 32"),
-              std::string::npos)
-        << e.what();
-  }
+  expect_error([&] { opt::minimize_sao(*small, o, s); },
+               "sao.samples.initial = 64: must be <= the problem's largest sample size 32");
   // YAML: the section is read, and written only when on
   const std::string text = opt::to_yaml(opt::SaoOptions{});
   EXPECT_EQ(text.find("samples"), std::string::npos) << text;

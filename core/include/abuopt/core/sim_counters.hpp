@@ -21,6 +21,15 @@ struct SimCounters {
   long polishes = 0;          // roots refined on the Runge-Kutta solution (hard contact)
   long polish_steps = 0;      // the Runge-Kutta steps those refinements took
   long dips = 0;              // hard contact: gaps that closed and opened again inside one step
+  // Hard contact: choices of clusters and modes at events (sim_contact_modes.cpp), the flips of
+  // the pivoting, and the choices where pivoting failed and every joint option was enumerated.
+  long mode_choices = 0;
+  long mode_pivots = 0;
+  long mode_fallbacks = 0;
+  // ContactChoiceMethod::Compare only: choices where the enumeration chose otherwise, and where
+  // the enumeration found a consistent option.
+  long mode_differs = 0;
+  long mode_enum_consistent = 0;
 };
 
 SimCounters& sim_counters();

@@ -77,6 +77,10 @@ struct ProblemSpec {
   // fresh runs of a seed no optimiser saw); empty: none. Called once per run on the result's x
   // (thread-safe: runs may go at once), never for a run without a point.
   std::function<Evaluation(const std::vector<double>& x)> validate;
+  // What the evaluation archive keys this problem's values by (ComparisonSetup::archive_directory):
+  // a value stored under one identity never answers another. Give a hash of everything that fixes
+  // the values (the startup problem: its archive id); empty: the label.
+  std::string identity;
 };
 
 struct RunRecord;
@@ -88,6 +92,19 @@ struct ComparisonSetup {
   std::string true_objective_metric = "noise_free_objective";
   // Called after each run (e.g. to print progress), in run order; may be empty.
   std::function<void(const RunRecord&)> on_run;
+  // Called as each run ends (a progress line), from the thread that ran it, one call at a time,
+  // with the runs ended so far and the total of the comparison; f* is not known yet, so
+  // evaluations_to_solve is -1. May be empty.
+  std::function<void(const RunRecord&, std::size_t ended, std::size_t total)> on_run_ended;
+  // Resumable comparison: when not empty, every run keeps its evaluations in an evaluation archive
+  // of its own (evaluation_archive.hpp), <archive_directory>/<problem>/start<k>-<solver>.sqlite,
+  // and the out-of-sample checks go into <archive_directory>/<problem>/validation.sqlite. A rerun
+  // answers what is stored bit for bit; the optimisers are deterministic, so an interrupted run
+  // retraces its path from the archive and goes on from where it stopped, and a finished run is
+  // replayed without computing anything (RunRecord::result.archive_hits counts the answers). The
+  // problems' identities key the values (ProblemSpec::identity). No run handles SIGINT itself then:
+  // Ctrl-C ends the comparison at once, and every evaluation stored so far stays.
+  std::string archive_directory;
   // Runs of one problem at once (its starts x solvers are independent); the results do not
   // depend on it (only wall times do). 1: one after another. Each run's own Monte Carlo threads
   // come on top, so for the startup problem keep threads x montecarlo.threads near the cores.
@@ -106,6 +123,7 @@ struct RunRecord {
   std::string solver;
   int start = 0;                   // index of the starting point
   std::size_t dimension = 0;       // n_p
+  std::size_t sample_size = 0;     // the problem's own Monte Carlo size (Problem::sample_size())
   std::vector<double> x0;
   OptimizationResult result;       // with its history
   double best_true_objective = std::numeric_limits<double>::infinity();  // best feasible (true f)
@@ -115,6 +133,7 @@ struct RunRecord {
   // ProblemSpec::validate of result.x (unset without one); feasible within the run's tolerance
   std::optional<Evaluation> validation;
   bool validation_feasible = false;
+  bool validation_from_archive = false;  // the validation was answered by the archive
 };
 
 struct ComparisonResult {
@@ -141,7 +160,16 @@ std::vector<std::vector<double>> starting_points(const Problem& problem, int sta
 
 // Evaluations until the first feasible point with f - f* <= tau max(|f*|, 1); -1 if none.
 long evaluations_to_solve(const OptimizationResult& result, double f_star, double tau,
-                          const std::string& true_objective_metric = "noise_free_objective");
+                          const std::string& true_objective_metric = "noise_free_objective",
+                          std::size_t full_sample_size = 0);
+// Whether an evaluation counts as a value of the problem (for "solved", the best value and the
+// convergence curve): always, unless the problem is sampled (full_sample_size > 0, its own Monte
+// Carlo size), the evaluation has no true_objective_metric (a noise-free value) and its metric
+// `runs` is below full_sample_size: a value of SAO's adaptive sample size on fewer runs is an
+// estimate of another, noisier statistic (its minimum over many designs is biased low), so a
+// comparison judges every solver on values at the problem's own size.
+bool counts_as_problem_value(const EvaluationRecord& h, std::size_t full_sample_size,
+                             const std::string& true_objective_metric);
 
 // ---- profile arithmetic (t: rows = instances, columns = solvers, +inf = not solved) ----
 // d_s(alpha) for each alpha: fraction of rows with t[p][s] <= alpha (dims[p] + 1).
