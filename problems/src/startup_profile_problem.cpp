@@ -10,6 +10,7 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/core/batch_runner.hpp"
+#include "abuopt/core/model_version.hpp"
 #include "abuopt/core/monte_carlo_stats.hpp"
 #include "abuopt/core/simulation_config.hpp"
 #include "abuopt/optimizer/penalty_problem.hpp"
@@ -336,7 +337,12 @@ opt::Evaluation StartupProfileProblem::evaluate_with_threads(const StartupProfil
 std::string StartupProfileProblem::identity_text() const {
   // Every identity field of the field lists (bounds, x0, scales, threads and the validation
   // section are marked out of it): a new key is in the identity as soon as it is described.
-  return "# abuopt startup_profile problem, evaluation v2\n" + identity_fields(settings_);
+  // With hard contact the contact model's version too (core/model_version.hpp): archives of an
+  // older contact model do not answer; the identities of runs without contact stay as they were.
+  std::string text = "# abuopt startup_profile problem, evaluation v2\n";
+  if (settings_.study.setup.abu.ball_contact == BallContact::Hard)
+    text += "# contact model v" + std::to_string(kContactModelVersion) + "\n";
+  return text + identity_fields(settings_);
 }
 
 std::string StartupProfileProblem::identity() const {

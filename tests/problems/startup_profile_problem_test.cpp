@@ -11,6 +11,7 @@
 #include <string>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/core/model_version.hpp"
 #include "abuopt/core/monte_carlo.hpp"
 #include "abuopt/core/monte_carlo_stats.hpp"
 #include "abuopt/core/simulation_config.hpp"
@@ -330,6 +331,13 @@ TEST(StartupProfileProblem, IdentityChangesWithWhatDecidesTheValues) {
   EXPECT_EQ(changed("{min: 15, max: 28, x0: 25}", "{min: 14, max: 28, x0: 20}"), base);
   EXPECT_EQ(changed("threads: 1", "threads: 2"), base);
   EXPECT_EQ(changed("montecarlo:", "validation: {runs: 64}\nmontecarlo:"), base);
+  // Hard contact: a new identity, and it names the contact model's version, so that archives of an
+  // older contact model (before the pivoting choice of modes) never answer for this one.
+  const StartupProfileProblem contact(settings_from("abu: {ball_contact: hard}\n" + kThreeStep));
+  EXPECT_NE(contact.identity(), base);
+  EXPECT_NE(contact.identity_text().find("# contact model v" + std::to_string(kContactModelVersion) + "\n"),
+            std::string::npos);
+  EXPECT_EQ(StartupProfileProblem(settings_from(kThreeStep)).identity_text().find("contact model"), std::string::npos);
 
   EXPECT_NE(problems::fnv1a64("a"), problems::fnv1a64("b"));
   EXPECT_EQ(problems::fnv1a64(""), 14695981039346656037ull);  // FNV-1a offset basis

@@ -1,0 +1,14 @@
+#pragma once
+// Versions of the simulator's models, for the keys of stored results (docs/archive.md, "Model
+// versions"). Raise one when a change moves that model's results beyond rounding: the startup-profile
+// problem puts it into its identity, so an archive written before the change never answers for the
+// new model (it is kept, under the old identity), while the results of the other models stay valid.
+
+namespace abuopt {
+
+// Hard ball-ball contact (abu.ball_contact: hard). 1: modes chosen by enumeration, a forced block
+// released forward whatever margin crossed; 2: pivoting choice, a forced block released only in the
+// direction whose margin crossed (docs/model.md 11.8).
+inline constexpr int kContactModelVersion = 2;
+
+}  // namespace abuopt
