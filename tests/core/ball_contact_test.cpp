@@ -176,6 +176,24 @@ void no_final_overlap(std::uint64_t seed, int n, int balls) {
 TEST(BallContact, NoFinalStateOverlapsTwoBalls) { no_final_overlap(101, 96, 2); }
 TEST(BallContact, NoFinalStateOverlapsFourBalls) { no_final_overlap(202, 48, 4); }
 
+namespace {
+
+// 16 random starts of setup s (the balls' count from s, angles from seed): every run ends ok, and no
+// two balls overlap at the end by more than -min_clearance rad.
+void expect_random_starts_end_ok(const SimulationSetup& s, std::uint64_t seed, double min_clearance) {
+  Simulator sim(s);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 2 * M_PI);
+  for (int k = 0; k < 16; ++k) {
+    std::vector<double> beta(s.abu.balls.size());
+    for (double& x : beta) x = u(rng);
+    const RunOutcome o = sim.run(beta);
+    EXPECT_TRUE(o.ok()) << "start " << k << ": " << o.message;
+    EXPECT_GE(min_contact_clearance(s.abu, o.beta_final), min_clearance) << "start " << k;
+  }
+}
+
+}  // namespace
 
 // Nine balls of equal total mass (2.8e-4 kg, the study's formulation 4; d ~ m^(1/3)): chains of
 // touching balls give more joint cluster/mode options than the enumeration takes (20 000). The
@@ -188,16 +206,7 @@ TEST(BallContact, NineBallsOfEqualTotalMassEndOkWithoutOverlap) {
   b.mass_kg = 2.8e-4 / 9;
   b.diameter_m = 3e-3 * std::cbrt(2.0 / 9);
   s.abu.balls.assign(9, b);
-  Simulator sim(s);
-  std::mt19937_64 rng(2003);
-  std::uniform_real_distribution<double> u(0, 2 * M_PI);
-  for (int k = 0; k < 16; ++k) {
-    std::vector<double> beta(9);
-    for (double& x : beta) x = u(rng);
-    const RunOutcome o = sim.run(beta);
-    EXPECT_TRUE(o.ok()) << "start " << k << ": " << o.message;
-    EXPECT_GE(min_contact_clearance(s.abu, o.beta_final), -1e-12) << "start " << k;
-  }
+  expect_random_starts_end_ok(s, 2003, -1e-12);
 }
 
 // Chains of identical report balls (9 balls, 4.5x the report's ball mass): before forced blocks
@@ -208,14 +217,5 @@ TEST(BallContact, NineIdenticalBallsInChainsEndOk) {
   SimulationSetup s;
   s.abu.ball_contact = BallContact::Hard;
   s.abu.balls.assign(9, Ball{});
-  Simulator sim(s);
-  std::mt19937_64 rng(4242);
-  std::uniform_real_distribution<double> u(0, 2 * M_PI);
-  for (int k = 0; k < 16; ++k) {
-    std::vector<double> beta(9);
-    for (double& x : beta) x = u(rng);
-    const RunOutcome o = sim.run(beta);
-    EXPECT_TRUE(o.ok()) << "start " << k << ": " << o.message;
-    EXPECT_GE(min_contact_clearance(s.abu, o.beta_final), -1e-11) << "start " << k;
-  }
+  expect_random_starts_end_ok(s, 4242, -1e-11);
 }
