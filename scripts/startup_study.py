@@ -723,14 +723,19 @@ def write_summary(st, designs, table, balls, best19):
     make_plots(st, table, designs, best19)
 
 
-def settle_frequency(profile, t):
-    t0, f0 = 0.0, profile.get("start_frequency_hz", 0.0)
-    for fe, dt in segments_of(profile):
+def frequency_at(segs, t, f0=0.0):
+    """The frequency at time t of inclined-sine segments [(end_frequency_hz, duration_s)] from f0 Hz."""
+    t0 = 0.0
+    for fe, dt in segs:
         if t <= t0 + dt:
             phi = 2 * math.pi * (t - t0) / dt
             return f0 + (fe - f0) / (2 * math.pi) * (phi - math.sin(phi))
         t0, f0 = t0 + dt, fe
     return f0
+
+
+def settle_frequency(profile, t):
+    return frequency_at(segments_of(profile), t, profile.get("start_frequency_hz", 0.0))
 
 
 def final_positions_plot(st, table, names, gp):

@@ -28,6 +28,9 @@ import shutil
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from startup_study import frequency_at  # noqa: E402  (the inclined-sine profile, one definition)
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 # The report's ABU (spec table 3.2; configs/eqset.yaml): M = table + imbalance + two balls.
@@ -57,17 +60,6 @@ def segments(kind, f_h, d):
     if kind == "down":
         s.append((30.0, 5.0))
     return s + [(f_h, d), (f_h, HOLD_S), (100.0, LAST_S)]
-
-
-def frequency_at(segs, t):
-    """The profile's frequency at time t (inclined sines from 0 Hz)."""
-    t0, f0 = 0.0, 0.0
-    for fe, dt in segs:
-        if t <= t0 + dt:
-            phi = 2 * math.pi * (t - t0) / dt
-            return f0 + (fe - f0) / (2 * math.pi) * (phi - math.sin(phi))
-        t0, f0 = t0 + dt, fe
-    return f0
 
 
 def config_text(segs, mu, runs, seed):
