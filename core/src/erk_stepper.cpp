@@ -65,6 +65,8 @@ ErkStepper::ErkStepper(ButcherTable table, std::size_t n, RhsFn f, RootFn g, std
   bt_.resize(nroots);
   bg_.resize(nroots);
   gtmp_.resize(nroots);
+  gdtmp_.assign(nroots, 0.0);
+  ycache_.resize(n);
   found_.assign(nroots, 0);
 }
 
@@ -75,6 +77,7 @@ void ErkStepper::reset(double t, const double* y) {
   ++nf_;
   ++ctr_.resets;
   since_reset_ = 0;
+  cache_valid_ = false;
   if (g_ && nroots_) {
     g_(t_, y_.data(), g0_.data(), user_);
     ++ctr_.root_evaluations;
@@ -162,6 +165,7 @@ ErkStepper::Status ErkStepper::step() {
       ++since_reset_;
       // accept
       tprev_ = t_;
+      cache_valid_ = false;
       yprev_.swap(y_);
       fprev_.swap(f0_);
       t_ = to_stop ? tstop_ : t_ + h;
@@ -235,28 +239,25 @@ ErkStepper::Status ErkStepper::step() {
         troot = tk;
         first = static_cast<int>(k);
         if (order_.size() > 1) {  // the signs at troot, for the functions still to come
-          const long nf_before = nf_;
-          attempt(tprev_, yprev_.data(), fprev_.data(), troot - tprev_, ynew_.data());
-          ctr_.rhs_root += nf_ - nf_before;
-          g_(troot, ynew_.data(), groot_.data(), user_);
+          state_at(troot);
+          g_(troot, ycache_.data(), groot_.data(), user_);
           ++ctr_.root_evaluations;
         }
       }
     }
   }
   // Recompute the state at the root with a fresh RK step from the step's start.
-  const long nf_before_root = nf_;
   const double hroot = troot - tprev_;
   if (hroot > 0) {
-    attempt(tprev_, yprev_.data(), fprev_.data(), hroot, ynew_.data());
-    y_ = ynew_;
+    state_at(troot);
+    y_ = ycache_;
   } else {
     y_ = yprev_;
   }
   t_ = troot;
   f_(t_, y_.data(), f0_.data(), user_);  // keeps dense() consistent on [tprev, troot]
   ++nf_;
-  ctr_.rhs_root += nf_ - nf_before_root;
+  ++ctr_.rhs_root;
   g_(t_, y_.data(), g1_.data(), user_);
   ++ctr_.root_evaluations;
   std::fill(found_.begin(), found_.end(), 0);
@@ -287,10 +288,8 @@ void ErkStepper::find_dips() {
     if (s * (g0 + u * (a1 + u * (a2 + u * a3))) > 0) continue;  // the interpolant stays on its side
     const double tm = tprev_ + u * h;
     if (!(tm > tprev_ && tm < t_)) continue;
-    const long nf_before = nf_;
-    attempt(tprev_, yprev_.data(), fprev_.data(), tm - tprev_, ynew_.data());  // on the RK solution
-    ctr_.rhs_root += nf_ - nf_before;
-    g_(tm, ynew_.data(), gtmp_.data(), user_);
+    state_at(tm);  // on the RK solution
+    g_(tm, ycache_.data(), gtmp_.data(), user_);
     ++ctr_.root_evaluations;
     if (s * gtmp_[k] > 0) continue;
     ++ctr_.dips;
@@ -299,17 +298,59 @@ void ErkStepper::find_dips() {
   }
 }
 
+double ErkStepper::state_at(double tc) {
+  // the last state computed from this step's start is reused (attempt() is deterministic, so a
+  // reuse is bit-identical to a recomputation)
+  if (cache_valid_ && tc == tcache_) return tc;
+  const long nf_before = nf_;
+  attempt(tprev_, yprev_.data(), fprev_.data(), tc - tprev_, ycache_.data());
+  ctr_.rhs_root += nf_ - nf_before;
+  tcache_ = tc;
+  cache_valid_ = true;
+  return tc;
+}
+
 double ErkStepper::polish(std::size_t k, double ta, double ga, double tb, double gb, double hint) {
   ++ctr_.polishes;
   auto g = [&](double tc) {
     ++ctr_.polish_steps;
-    const long nf_before = nf_;
-    attempt(tprev_, yprev_.data(), fprev_.data(), tc - tprev_, ynew_.data());
-    ctr_.rhs_root += nf_ - nf_before;
-    g_(tc, ynew_.data(), gtmp_.data(), user_);
+    state_at(tc);
+    g_(tc, ycache_.data(), gtmp_.data(), user_);
     ++ctr_.root_evaluations;
     return gtmp_[k];
   };
+  if (gd_) {
+    // Newton on the Runge-Kutta solution for a function whose rate is known (a gap: linear in the
+    // state, rate = the relative speed; docs/model.md 11.9), from the interpolant's root. The
+    // time tolerance is derived: a time error dt moves the gap by |rate| dt, which is held to
+    // kEventGapTol (1e-3 of atol). The last point is put just past the predicted root, on tb's
+    // side, so the event state has crossed (gap <= 0 by at most |rate| tol); the event handler
+    // projects the gap to zero.
+    const bool start_negative = ga < 0;  // ga != 0: the function's side before the crossing
+    double tc = hint > ta && hint < tb ? hint : 0.5 * (ta + tb);
+    for (int it = 0; it < 4; ++it) {
+      const double gc = g(tc);
+      if (gc == 0.0) return tc;
+      const bool crossed = (gc < 0) != start_negative;
+      if (crossed) {
+        tb = tc;
+        gb = gc;
+      } else {
+        ta = tc;
+        ga = gc;
+      }
+      gd_(tc, ycache_.data(), gdtmp_.data(), user_);
+      const double rate = gdtmp_[k];
+      if (!(std::isfinite(rate) && rate != 0.0)) break;
+      const double tol = std::max(4e-16 * std::max(1.0, std::fabs(tb)), atol_ * kEventGapTol / std::fabs(rate));
+      const double d = -gc / rate;
+      if (crossed && std::fabs(d) <= tol) return tc;   // crossed, within the tolerance of the root
+      const double tn = tc + d + 0.5 * tol;  // just past the predicted root
+      if (!(tn > ta && tn < tb)) break;
+      tc = tn;
+    }
+    if (std::fabs(tb - ta) <= 4e-16 * std::max(1.0, std::fabs(tb))) return tb;
+  }
   // the interpolant's root first, with a closing point 1e-6 of the step beyond it (the
   // interpolant's error in the root time is far smaller)
   return refine_crossing(g, ta, ga, tb, gb, 4e-16 * std::max(1.0, std::fabs(tb)), hint, 1e-6 * (tb - ta));

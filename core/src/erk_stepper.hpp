@@ -30,6 +30,10 @@ struct ButcherTable {
 using RhsFn = void (*)(double t, const double* y, double* dydt, void* user);
 using RootFn = void (*)(double t, const double* y, double* g, void* user);
 
+// A located event's gap error allowed, as a fraction of the absolute state tolerance atol
+// (docs/model.md 11.9): the time tolerance of a gap's root is atol * kEventGapTol / |its rate|.
+constexpr double kEventGapTol = 1e-3;
+
 class ErkStepper {
  public:
     // NotFinite: the state, its derivative or the step size is not finite (NaN or inf): the run
@@ -72,9 +76,16 @@ class ErkStepper {
   // With rates (gd_): functions that dip through zero and back inside the step get the bracket
   // [tprev, their extremum] (bt_, bg_).
   void find_dips();
-  // hint: the root on the interpolant (the first trial point).
+  // hint: the root on the interpolant (the first trial point). Functions with a known rate (gd_)
+  // by Newton's method to a derived time tolerance, the others by refine_crossing to 2 ulp.
   double polish(std::size_t k, double ta, double ga, double tb, double gb, double hint);
   bool polish_ = false;
+  // The Runge-Kutta state at tc by one step from the step's start, into ycache_ (reused when tc
+  // is the last time asked for in this step). Returns tc.
+  double state_at(double tc);
+  std::vector<double> ycache_, gdtmp_;
+  double tcache_ = 0;
+  bool cache_valid_ = false;
   double initial_step() ;
 
   ButcherTable tab_;

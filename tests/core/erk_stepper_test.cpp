@@ -274,3 +274,66 @@ TEST(ErkStepper, ARootFunctionThatDipsThroughZeroInsideAStepIsFoundWithItsRate) 
     EXPECT_NEAR(st.y()[0], 0.0, 1e-12);
   }
 }
+
+namespace {
+// A gap closing on a known trajectory: y = (sin t, cos t); the "gap" g = 0.8 - y0 (a ball at
+// sin t approaching a resting ball at 0.8) closes at t* = asin(0.8), at the rate g' = -y1 = -0.6.
+void closing_gap(double, const double* y, double* g, void*) { g[0] = 0.8 - y[0]; }
+void closing_gap_rate(double, const double* y, double* gd, void*) { gd[0] = -y[1]; }
+
+struct GapEvent {
+  double t = NAN, g = NAN;
+  long polishes = 0, polish_steps = 0;
+};
+GapEvent locate_gap(bool rates, double rtol, double atol) {
+  ErkStepper st(ButcherTable::from_arkode("ARKODE_FEHLBERG_13_7_8"), 2, oscillator, closing_gap, 1, nullptr, rtol, atol,
+                100000);
+  st.set_polish_roots(true);
+  if (rates) st.set_root_rates(closing_gap_rate);
+  const double y0[2] = {0.0, 1.0};
+  const abuopt::SimCounters before = abuopt::sim_counters();
+  st.reset(0.0, y0);
+  st.set_stop_time(2.0);
+  ErkStepper::Status s = ErkStepper::Ok;
+  while (s == ErkStepper::Ok) s = st.step();
+  GapEvent ev;
+  if (s != ErkStepper::Root) return ev;
+  ev.t = st.t();
+  closing_gap(ev.t, st.y().data(), &ev.g, nullptr);
+  ev.polishes = abuopt::sim_counters().polishes - before.polishes;
+  ev.polish_steps = abuopt::sim_counters().polish_steps - before.polish_steps;
+  return ev;
+}
+}  // namespace
+
+// Newton on the Runge-Kutta solution for a root function with a known rate (a gap; docs/model.md
+// 11.9): the time tolerance is atol * kEventGapTol / |rate|, and the state at the event has just
+// crossed (gap in [-|rate| tol, 0]), for the event handler to project to zero.
+TEST(ErkStepper, AClosingGapIsLocatedByNewtonToItsDerivedTolerance) {
+  const double t_star = std::asin(0.8);
+  // tight tolerances: the Runge-Kutta solution is exact to ~1e-13, so the located time is the
+  // closed form's to that over the rate (|g'| = 0.6), plus the time tolerance (rounding here)
+  const GapEvent tight = locate_gap(true, 1e-12, 1e-14);
+  ASSERT_TRUE(std::isfinite(tight.t));
+  EXPECT_NEAR(tight.t, t_star, 1e-12);
+  EXPECT_LE(tight.g, 0.0);
+  EXPECT_GE(tight.g, -1e-13);
+  // default tolerances: against the 2-ulp polish (Illinois with closing points) of the same
+  // Runge-Kutta solution, the Newton root is within the derived tolerance, on the crossed side
+  const double rtol = 1e-6, atol = 1e-9;
+  const GapEvent newton = locate_gap(true, rtol, atol), ulp = locate_gap(false, rtol, atol);
+  ASSERT_TRUE(std::isfinite(newton.t) && std::isfinite(ulp.t));
+  const double tol_t = atol * abuopt::detail::kEventGapTol / 0.6;  // 1.7e-12
+  EXPECT_NEAR(newton.t, ulp.t, tol_t);
+  EXPECT_GE(newton.t, ulp.t - 4e-16);  // never before the crossing
+  EXPECT_LE(newton.g, 0.0);
+  EXPECT_GE(newton.g, -0.6 * tol_t * 1.01);
+  EXPECT_NEAR(ulp.g, 0.0, 1e-15);
+  // both near the closed form within the method's error at rtol 1e-6 (~1e-8 in y, over 0.6)
+  EXPECT_NEAR(newton.t, t_star, 1e-7);
+  // cost: Newton takes at most 3 Runge-Kutta evaluations for the root (the interpolant's root,
+  // one Newton step landing past the root, the check), the 2-ulp polish more
+  EXPECT_EQ(newton.polishes, 1);
+  EXPECT_LE(newton.polish_steps, 3);
+  EXPECT_GT(ulp.polish_steps, newton.polish_steps);
+}
