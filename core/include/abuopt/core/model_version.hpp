@@ -8,7 +8,8 @@ namespace abuopt {
 
 // Hard ball-ball contact (abu.ball_contact: hard). 1: modes chosen by enumeration, a forced block
 // released forward whatever margin crossed; 2: pivoting choice, a forced block released only in the
-// direction whose margin crossed (docs/model.md 11.8).
-inline constexpr int kContactModelVersion = 2;
+// direction whose margin crossed (docs/model.md 11.8); 3: gap events located by Newton on the
+// Runge-Kutta solution to a derived tolerance instead of 2 ulp (docs/model.md 11.9).
+inline constexpr int kContactModelVersion = 3;
 
 }  // namespace abuopt
