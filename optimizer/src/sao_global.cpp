@@ -1,8 +1,9 @@
-// SAO's optional global phase (docs/sao.md, "Global phase"): a maximin Latin hypercube over the
-// whole box, then infill points that maximise the constrained expected improvement of kriging
-// models (Schonlau, Welch and Jones 1998: EI times the probability of feasibility), and the local
-// trust region starts from the known point of lowest merit. Without it a random start decides in
-// which basin the trust region ends.
+// SAO's global phase (docs/sao.md, "Global phase"; on by default on stochastic problems): a
+// maximin Latin hypercube over the whole box, then infill points that maximise the constrained
+// expected improvement of kriging models (Schonlau, Welch and Jones 1998: EI times the probability
+// of feasibility), and the local trust region starts from the incumbent. Without it a random start
+// decides in which basin the trust region ends. Also the restarts: after the trust region
+// converges with budget left, n + 1 more infill points and a new trust region at the incumbent.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
