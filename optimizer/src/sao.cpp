@@ -75,23 +75,33 @@ void SaoRun::run(const std::vector<double>& x0) {
   centre_z_ = known_[centre_].z;
   mu_ = sao_.penalty_initial > 0 ? sao_.penalty_initial
                                  : 10.0 * std::max(1.0, known_[centre_].ok ? std::fabs(known_[centre_].f) : 1.0);
-  if (sao_.global_phase.points > 0 && !global_phase()) return;
+  if (global_ && !global_phase()) return;
 
   int stalled = 0;
   int failures_in_a_row = 0;  // steps rejected or with rho <= rho_shrink
   double streak_radius = radius_;  // the radius before the first of them
   while (true) {
-    if (radius_ < sao_.min_radius) {
-      reason = TerminationReason::ConvergedXtol;
-      message = "trust region radius " + format_number(radius_) + " below min_radius " +
-                format_number(sao_.min_radius);
-      return;
-    }
-    if (stalled >= sao_.stall_iterations) {
-      reason = TerminationReason::ConvergedFtol;
-      message = "no improvement of the merit by more than stall_tolerance in " +
-                std::to_string(sao_.stall_iterations) + " iterations";
-      return;
+    if (radius_ < sao_.min_radius || stalled >= sao_.stall_iterations) {
+      if (radius_ < sao_.min_radius) {
+        reason = TerminationReason::ConvergedXtol;
+        message = "trust region radius " + format_number(radius_) + " below min_radius " +
+                  format_number(sao_.min_radius);
+      } else {
+        reason = TerminationReason::ConvergedFtol;
+        message = "no improvement of the merit by more than stall_tolerance in " +
+                  std::to_string(sao_.stall_iterations) + " iterations";
+      }
+      // converged with budget left: infill points and a new trust region (docs/sao.md, "Global
+      // phase", restarts); the result is the best point of the whole run (the driver's)
+      if (!restart_wanted()) return;
+      const std::optional<bool> restarted = restart();
+      if (!restarted || !*restarted) return;
+      ++restarts_;
+      message += "; restart " + std::to_string(restarts_);
+      stalled = 0;
+      failures_in_a_row = 0;
+      streak_radius = radius_;
+      continue;
     }
     if (options_.max_iterations > 0 && iterations >= options_.max_iterations) {
       reason = TerminationReason::MaxIterations;

@@ -1,8 +1,9 @@
-// SAO's optional global phase (docs/sao.md, "Global phase"): a maximin Latin hypercube over the
-// whole box, then infill points that maximise the constrained expected improvement of kriging
-// models (Schonlau, Welch and Jones 1998: EI times the probability of feasibility), and the local
-// trust region starts from the known point of lowest merit. Without it a random start decides in
-// which basin the trust region ends.
+// SAO's global phase (docs/sao.md, "Global phase"; on by default on stochastic problems): a
+// maximin Latin hypercube over the whole box, then infill points that maximise the constrained
+// expected improvement of kriging models (Schonlau, Welch and Jones 1998: EI times the probability
+// of feasibility), and the local trust region starts from the incumbent. Without it a random start
+// decides in which basin the trust region ends. Also the restarts: after the trust region
+// converges with budget left, n + 1 more infill points and a new trust region at the incumbent.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -27,6 +28,12 @@ constexpr double kEqualityBand = 0.05;
 // Floor of EI and of the probability of feasibility before the logarithm (the acquisition is
 // maximised as ln EI + sum ln P, which keeps its differences where both underflow).
 constexpr double kTiny = 1e-300;
+// The kriging models of the infill see at most kModelPointsPerDimension (n + 1) points: the best
+// half by merit and a maximin-spread rest (docs/sao.md, "Global phase"). A kriging fit costs
+// O(m^3) per likelihood evaluation; without the cap, restarts late in a run of 400 evaluations fit
+// 400 points (tens of seconds per infill point). The phase at its automatic size, 8 (n + 1) + 1
+// points, stays under it.
+constexpr int kModelPointsPerDimension = 10;
 
 double normal_cdf(double u) { return 0.5 * std::erfc(-u / std::sqrt(2.0)); }
 double normal_pdf(double u) { return std::exp(-0.5 * u * u) / std::sqrt(2.0 * std::numbers::pi); }
@@ -73,9 +80,10 @@ struct Acquisition {
 bool SaoRun::global_phase() {
   const SaoGlobalPhase& gp = sao_.global_phase;
   const std::uint64_t seed = options_.seed * 2654435761ULL + 97;
+  const long budget = options_.max_evaluations;
   // 1. the space-filling design over the whole box ([-1,1]^n from doe.hpp mapped to [0,1]^n)
   surrogate::LatinHypercubeOptions lhs;
-  lhs.points = gp.points;
+  lhs.points = gp.design_points(n_, budget);
   lhs.candidates = 20;
   lhs.seed = seed;
   const Eigen::MatrixXd design = surrogate::latin_hypercube(n_, lhs);
@@ -85,22 +93,56 @@ bool SaoRun::global_phase() {
   }
 
   // 2. infill by constrained expected improvement
+  if (!global_infill(gp.infill_points(n_, budget))) return false;
+  // 3. the trust region starts from the incumbent
+  centre_ = incumbent();
+  centre_z_ = known_[centre_].z;
+  return true;
+}
+
+bool SaoRun::global_infill(int count) {
+  // one random stream per call (the calls of a run are in a fixed order: results repeat)
+  const std::uint64_t seed = options_.seed * 2654435761ULL + 97 + 1000003ULL * infill_calls_++;
   std::mt19937_64 rng(seed + 1);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   const double tol = options_.constraint_tolerance;
-  for (int it = 0; it < gp.iterations; ++it) {
+  for (int it = 0; it < count; ++it) {
+    const std::size_t responses = 1 + m_ineq_ + m_eq_;
+    // every ok point whose values at the current sample size are known (sao_sampling.cpp)
     std::vector<const KnownPoint*> pts;
-    for (const KnownPoint& p : known_)
-      if (p.ok) pts.push_back(&p);
+    for (const KnownPoint& p : known_) {
+      bool usable = p.ok;
+      for (std::size_t k = 0; usable && k < responses; ++k) usable = fit_value(p, k).has_value();
+      if (usable) pts.push_back(&p);
+    }
+    const std::size_t cap = static_cast<std::size_t>(kModelPointsPerDimension * (n_ + 1));
+    if (pts.size() > cap) {
+      // the best half by merit (stable: ties keep the order of evaluation) ...
+      std::stable_sort(pts.begin(), pts.end(),
+                       [&](const KnownPoint* a, const KnownPoint* b) { return merit(*a) < merit(*b); });
+      std::vector<const KnownPoint*> chosen(pts.begin(), pts.begin() + cap / 2);
+      std::vector<const KnownPoint*> rest(pts.begin() + cap / 2, pts.end());
+      // ... then, one at a time, the remaining point farthest (infinity norm) from the chosen ones
+      std::vector<double> gap(rest.size(), kInf);
+      for (std::size_t i = 0; i < rest.size(); ++i)
+        for (const KnownPoint* c : chosen) gap[i] = std::min(gap[i], (rest[i]->z - c->z).cwiseAbs().maxCoeff());
+      while (chosen.size() < cap) {
+        std::size_t far = 0;
+        for (std::size_t i = 0; i < rest.size(); ++i)
+          if (gap[i] > gap[far]) far = i;
+        chosen.push_back(rest[far]);
+        gap[far] = -1;  // taken
+        for (std::size_t i = 0; i < rest.size(); ++i)
+          if (gap[i] >= 0) gap[i] = std::min(gap[i], (rest[i]->z - rest[far]->z).cwiseAbs().maxCoeff());
+      }
+      pts = std::move(chosen);
+    }
     const int m = static_cast<int>(pts.size());
     if (m < 2) break;
     Eigen::MatrixXd X(m, n_);
     for (int i = 0; i < m; ++i) X.row(i) = pts[i]->z.transpose();
     Acquisition acq;
-    const std::size_t responses = 1 + m_ineq_ + m_eq_;
-    auto value = [&](const KnownPoint& p, std::size_t k) {
-      return k == 0 ? p.f : k <= m_ineq_ ? p.g[k - 1] : p.h[k - 1 - m_ineq_];
-    };
+    auto value = [&](const KnownPoint& p, std::size_t k) { return *fit_value(p, k); };
     try {
       for (std::size_t k = 0; k < responses; ++k) {
         Eigen::VectorXd y(m);
@@ -190,10 +232,16 @@ bool SaoRun::global_phase() {
     if (!evaluate(chosen)) return false;
   }
 
-  // 3. the trust region starts from the incumbent of the acquisition: the lowest objective among
-  // the points that satisfy every inequality (within the constraint tolerance) and every equality
-  // within its band (the phase's information on the objective); without one, from the point of
-  // lowest merit
+  return true;
+}
+
+std::size_t SaoRun::incumbent() const {
+  // the incumbent of the acquisition: the lowest objective among the points that satisfy every
+  // inequality (within the constraint tolerance) and every equality within its band (the phase's
+  // information on the objective); without one, the point of lowest merit. Only points at the
+  // current sample size compete (the ratio test compares the centre with new points at that size).
+  const double tol = options_.constraint_tolerance;
+  auto current = [&](const KnownPoint& p) { return p.ok && (!sampling_ || p.samples == samples_); };
   std::vector<double> band(m_eq_, tol);
   for (std::size_t j = 0; j < m_eq_; ++j) {
     double lo = kInf, hi = -kInf;
@@ -207,7 +255,7 @@ bool SaoRun::global_phase() {
   std::optional<std::size_t> start;
   for (std::size_t i = 0; i < known_.size(); ++i) {
     const KnownPoint& p = known_[i];
-    if (!p.ok) continue;
+    if (!current(p)) continue;
     bool feasible = true;
     for (std::size_t k = 0; k < m_ineq_; ++k) feasible = feasible && p.g[k] <= tol;
     for (std::size_t j = 0; j < m_eq_; ++j) feasible = feasible && std::fabs(p.h[j]) <= band[j];
@@ -216,10 +264,23 @@ bool SaoRun::global_phase() {
   if (!start) {
     start = centre_;
     for (std::size_t i = 0; i < known_.size(); ++i)
-      if (merit(known_[i]) < merit(known_[*start])) start = i;
+      if (current(known_[i]) && merit(known_[i]) < merit(known_[*start])) start = i;
   }
-  centre_ = *start;
+  return *start;
+}
+
+bool SaoRun::restart_wanted() const {
+  return global_ && sao_.global_phase.restart && options_.max_evaluations > 0 &&
+         options_.max_evaluations - driver_.evaluations() >= n_ + 2;
+}
+
+std::optional<bool> SaoRun::restart() {
+  const long before = driver_.evaluations();
+  if (!global_infill(n_ + 1)) return std::nullopt;
+  if (driver_.evaluations() == before) return false;  // every infill point was known already
+  centre_ = incumbent();
   centre_z_ = known_[centre_].z;
+  radius_ = sao_.initial_radius;
   return true;
 }
 

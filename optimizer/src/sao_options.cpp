@@ -70,6 +70,29 @@ const std::vector<std::string>& subproblem_solver_names() {
   return c;
 }
 
+const std::vector<std::string>& global_phase_mode_names() {
+  static const std::vector<std::string> c = {"auto", "always", "never"};
+  return c;
+}
+std::string to_string(GlobalPhaseMode mode) { return enum_to_string(mode, global_phase_mode_names()); }
+
+namespace {
+// The automatic size of the global phase: 4 (n + 1) points, a sixth of the budget at most, 2 at
+// least (docs/sao.md, "Global phase": 20 + 20 on hs071, n = 4, was the measured setting).
+int automatic_global_size(int n, long max_evaluations) {
+  long k = 4L * (n + 1);
+  if (max_evaluations > 0) k = std::min(k, max_evaluations / 6);
+  return static_cast<int>(std::max(2L, k));
+}
+}  // namespace
+
+int SaoGlobalPhase::design_points(int n, long max_evaluations) const {
+  return points > 0 ? points : automatic_global_size(n, max_evaluations);
+}
+int SaoGlobalPhase::infill_points(int n, long max_evaluations) const {
+  return points > 0 ? iterations : automatic_global_size(n, max_evaluations);
+}
+
 std::string to_string(SurrogateKind kind) { return enum_to_string(kind, surrogate_kind_names()); }
 std::string to_string(DoeKind kind) { return enum_to_string(kind, doe_kind_names()); }
 std::string to_string(InterveningKind kind) { return enum_to_string(kind, intervening_kind_names()); }
@@ -119,7 +142,7 @@ void SaoOptions::validate(const std::string& p) const {
           "must be >= 10");
   require_in(p, "kriging_nugget", kriging_nugget, "()", 0, 1);
   require(global_phase.points == 0 || global_phase.points >= 2, p + ".global_phase", "points", global_phase.points,
-          "must be 0 (no global phase) or >= 2");
+          "must be 0 (automatic size) or >= 2");
   require(global_phase.iterations == 0 || global_phase.points > 0, p + ".global_phase", "iterations",
           global_phase.iterations, "needs global_phase.points > 0 (the design the infill starts from)");
   require(samples.initial >= 0, p + ".samples", "initial", samples.initial, "must be 0 (off) or >= 1");
@@ -206,8 +229,11 @@ void describe_fields(FieldArchive& a, SaoSampling& o) {
 }
 
 void describe_fields(FieldArchive& a, SaoGlobalPhase& o) {
+  static const EnumNames<GlobalPhaseMode> modes = enum_names<GlobalPhaseMode>(global_phase_mode_names());
+  a.field("mode", o.mode, modes);
   a.field("points", o.points, Rule::in_range(0, 100000));
   a.field("iterations", o.iterations, Rule::in_range(0, 100000));
+  a.field("restart", o.restart);
 }
 
 SaoOptions read_sao_options(YamlReader& r) {

@@ -101,7 +101,8 @@ struct RegionBox {
 class SaoRun {
  public:
   SaoRun(Problem& problem, const OptimizerOptions& options, const SaoOptions& sao, EvaluationDriver& driver)
-      : options_(options), sao_(sao), driver_(driver), variables_(problem.variables()) {
+      : options_(options), sao_(sao), driver_(driver), variables_(problem.variables()),
+        global_(sao.global_phase.enabled(problem.stochastic())) {
     n_ = static_cast<int>(variables_.size());
     m_ineq_ = driver.n_inequality();
     m_eq_ = driver.n_equality();
@@ -186,10 +187,24 @@ class SaoRun {
                             const RegionBox& box) const;
   void update_penalty(const Models& models, const Eigen::VectorXd& s);
 
-  // ---- global phase (sao_global.cpp) ----
+  // ---- global phase and restarts (sao_global.cpp) ----
   // Space-filling design and constrained-expected-improvement infill over the whole box, then the
-  // centre moves to the known point of lowest merit. false: stopped.
+  // centre moves to the incumbent (incumbent()). false: stopped.
   bool global_phase();
+  // `count` infill points by constrained expected improvement of kriging models of every response
+  // on the known points (their values at the current sample size). false: stopped.
+  bool global_infill(int count);
+  // The lowest objective among the known points at the current sample size that satisfy every
+  // inequality within the constraint tolerance and every equality within its band; without one,
+  // the point of lowest merit (the centre if none is lower).
+  std::size_t incumbent() const;
+  // After the trust region converged with budget left: n + 1 infill points, then a new trust region
+  // of initial_radius at the incumbent. nullopt: stopped; false: no new point could be evaluated
+  // (the run ends as converged); true: restarted.
+  std::optional<bool> restart();
+  // Whether a converged trust region restarts: the global phase is on with `restart` and the
+  // budget (max_evaluations > 0) has at least n + 2 evaluations left.
+  bool restart_wanted() const;
 
   // ---- noise (sao_noise.cpp does the arithmetic) ----
   double merit_noise(const Models& models, bool phase1) const;
@@ -203,6 +218,9 @@ class SaoRun {
   const SaoOptions& sao_;
   EvaluationDriver& driver_;
   std::vector<Variable> variables_;
+  bool global_ = false;  // the global phase runs (SaoGlobalPhase::enabled for this problem)
+  int infill_calls_ = 0;
+  int restarts_ = 0;      // trust regions restarted after convergence  // global_infill calls so far (each its own random stream)
   int n_ = 0;
   std::size_t m_ineq_ = 0, m_eq_ = 0;
 

@@ -37,6 +37,7 @@ class RecordingProblem : public Problem {
   }
   std::vector<double> initial_point() const override { return inner_.initial_point(); }
   std::size_t sample_size() const override { return inner_.sample_size(); }
+  bool stochastic() const override { return inner_.stochastic(); }
   Evaluation evaluate(const std::vector<double>& x) override {
     Evaluation e;
     try {

@@ -162,6 +162,7 @@ class ArchivedProblem : public Problem {
   // answer), else under n.
   std::size_t sample_size() const override { return inner_.sample_size(); }
   std::size_t max_sample_size() const override { return inner_.max_sample_size(); }
+  bool stochastic() const override { return inner_.stochastic(); }
   Evaluation evaluate_sampled(const std::vector<double>& x, std::size_t n, std::size_t concurrent = 1) override;
   std::vector<BatchEvaluation> evaluate_batch_sampled(const std::vector<std::vector<double>>& xs, std::size_t n,
                                                       EvaluationScheduler& scheduler) override;

@@ -31,6 +31,7 @@ class PenaltyProblem : public Problem {
   }
   std::size_t sample_size() const override { return inner_->sample_size(); }
   std::size_t max_sample_size() const override { return inner_->max_sample_size(); }
+  bool stochastic() const override { return inner_->stochastic(); }
   Evaluation evaluate_sampled(const std::vector<double>& x, std::size_t n, std::size_t concurrent = 1) override {
     return penalise(inner_->evaluate_sampled(x, n, concurrent));
   }

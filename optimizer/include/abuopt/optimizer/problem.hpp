@@ -109,6 +109,13 @@ class Problem {
   virtual std::vector<BatchEvaluation> evaluate_batch_sampled(const std::vector<std::vector<double>>& xs,
                                                               std::size_t n, EvaluationScheduler& scheduler);
 
+  // ---- Noise (pagmo's problem::is_stochastic) ----
+  // True when evaluate(x) is an estimate with noise in it (a Monte Carlo mean, a noisy
+  // measurement), even if the same x gives the same value (common random numbers). SAO's global
+  // phase and restarts are on by default for such problems (docs/sao.md, "Global phase"). Default:
+  // a sampled problem (sample_size() > 0) is stochastic, any other is not.
+  virtual bool stochastic() const { return sample_size() > 0; }
+
   // Starting point when the caller gives none; default: the middle of the bounds.
   virtual std::vector<double> initial_point() const;
 

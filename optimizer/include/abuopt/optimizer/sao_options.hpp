@@ -40,17 +40,37 @@ const std::vector<std::string>& doe_kind_names();
 const std::vector<std::string>& intervening_kind_names();
 const std::vector<std::string>& subproblem_solver_names();
 
-// SAO's optional global phase (docs/sao.md, "Global phase"): before the local trust region, a
+// SAO's global phase (docs/sao.md, "Global phase"): before the local trust region, a
 // space-filling design over the whole box (a maximin Latin hypercube of `points` points besides
 // the start), then `iterations` infill points, each where the constrained expected improvement of
 // kriging models of the objective and of every constraint is largest; the trust region then starts
-// from the best point found (lowest exact-penalty merit). points 0: no global phase.
+// from the incumbent (the best point that satisfies the constraints). With `restart`, a trust
+// region that converges with budget left is followed by n + 1 more infill points and a new trust
+// region from the incumbent, until the budget is spent.
+//
+// When it runs (`mode`): auto (default) on a stochastic problem (Problem::stochastic(): a Monte
+// Carlo, a noisy benchmark) or when `points` is given, else not; always; never.
+// Its size: `points` 0 and `iterations` 0 (default) are automatic, 4 (n + 1) each, at most a sixth
+// of max_evaluations each (and at least 2 points).
 //
 //   sao: {global_phase: {points: 20, iterations: 20}}
+enum class GlobalPhaseMode { Auto, Always, Never };
 struct SaoGlobalPhase {
-  int points = 0;      // 0 (off) or >= 2
-  int iterations = 0;  // >= 0; needs points > 0
+  GlobalPhaseMode mode = GlobalPhaseMode::Auto;
+  int points = 0;      // 0 (automatic) or >= 2
+  int iterations = 0;  // >= 0; with points > 0 as given, else automatic
+  bool restart = true;  // restart from the incumbent after convergence with budget left
+
+  // Whether the phase runs on a problem (stochastic: Problem::stochastic()).
+  bool enabled(bool stochastic) const {
+    return mode == GlobalPhaseMode::Always || (mode == GlobalPhaseMode::Auto && (stochastic || points > 0));
+  }
+  // The design's point count and the infill count for n variables and a budget (0: none).
+  int design_points(int n, long max_evaluations) const;
+  int infill_points(int n, long max_evaluations) const;
 };
+const std::vector<std::string>& global_phase_mode_names();
+std::string to_string(GlobalPhaseMode mode);
 
 // SAO's sample size schedule for sampled problems (docs/sao.md, "Adaptive sample size"; the
 // problem must support Problem::evaluate_sampled): iteration k evaluates at

@@ -32,6 +32,7 @@ class NoisyProblem : public opt::Problem {
   opt::Evaluation evaluate(const std::vector<double>& x) override;
   std::size_t sample_size() const override { return samples_; }
   std::size_t max_sample_size() const override { return samples_; }
+  bool stochastic() const override { return amplitude_ > 0; }  // noise in every value
   opt::Evaluation evaluate_sampled(const std::vector<double>& x, std::size_t n, std::size_t concurrent = 1) override;
   std::vector<double> initial_point() const override { return inner_->initial_point(); }
   std::optional<opt::BestKnown> best_known() const override { return inner_->best_known(); }
