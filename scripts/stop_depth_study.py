@@ -10,12 +10,20 @@ duration D,
     down:  0 -> 25 Hz in 1 s, -> 30 Hz in 5 s, 30 Hz -> f_h in D (the sweep back of the best designs),
            hold f_h for 6 s, -> 100 Hz in 4.3 s
 
+and, with --family oscillate, the non-monotonic profiles of the issue (balls stuck at one speed are
+outside the set of another, so they slide again): n cycles of amplitude A and period P around f_c,
+
+    oscillate: 0 -> 25 Hz in 1 s, -> f_c + A in 3 s, n x [-> f_c - A in P/2, -> f_c + A in P/2],
+               -> f_d in P/2, hold f_d for 6 s, -> 100 Hz in 4.3 s
+
 each on the same random starts (abuopt montecarlo), and reports per case the final |I_r| in units of
 r_lock(mu) (mean, p10, median, p90, the share at or below the goal's 0.44 r_lock) and the stop depth
 |I_r| / r_in(f_s) at each run's settling frequency f_s (r_in: the inscribed disc of the set,
 docs/equilibrium_sets.md section 4; 1 = on the boundary, 0 = at a balancing point).
 
     python3 scripts/stop_depth_study.py --out results/stop_depth [--runs 1024] [--mu 0.02 0.03]
+    python3 scripts/stop_depth_study.py --family oscillate --out results/stop_depth_osc --runs 256 \
+        [--center 28.9 29.2 29.5] [--amplitude 0.2 0.5 1 1.5] [--period 0.5 1 2 4] [--cycles 1 2 4] [--dwell 28.93 29]
 
 Writes OUT/stop_depth.csv, OUT/stop_depth.md and OUT/stop_depth.png (gnuplot). Needs python3 only.
 """
@@ -62,6 +70,15 @@ def segments(kind, f_h, d):
     return s + [(f_h, d), (f_h, HOLD_S), (100.0, LAST_S)]
 
 
+def oscillation_segments(f_c, amp, period, cycles, f_d):
+    """0 -> 25 Hz in 1 s, -> f_c + A in 3 s, cycles x (down to f_c - A, up to f_c + A, P/2 each), -> f_d in P/2,
+    hold f_d, -> 100 Hz. Peak rate of a half cycle 2 (2 A) / (P / 2) = 8 A / P Hz/s."""
+    s = [FIRST, (f_c + amp, 3.0)]
+    for _ in range(cycles):
+        s += [(f_c - amp, period / 2), (f_c + amp, period / 2)]
+    return s + [(f_d, period / 2), (f_d, HOLD_S), (100.0, LAST_S)]
+
+
 def config_text(segs, mu, runs, seed):
     prof = "".join(f"    - {{end_frequency_hz: {f:.6g}, duration_s: {d:.6g}}}\n" for f, d in segs)
     return (f"abu:\n  friction_mu: {mu}\n  ball_contact: hard\nprofile:\n  start_frequency_hz: 0\n  segments:\n{prof}"
@@ -76,7 +93,19 @@ def quantile(v, q):
 
 def run_case(a, kind, f_h, d, mu):
     segs = segments(kind, f_h, d)
-    name = f"{kind}_f{f_h:g}_D{d:g}_mu{mu:g}"
+    peak_rate = 2 * abs(f_h - (30.0 if kind == "down" else 25.0)) / d  # Hz/s at the middle of the approach
+    row = {"kind": kind, "f_hold_hz": f_h, "approach_s": d, "approach_peak_hz_s": peak_rate}
+    return measure(a, f"{kind}_f{f_h:g}_D{d:g}_mu{mu:g}", segs, mu, row)
+
+
+def run_oscillation(a, f_c, amp, period, cycles, f_d, mu):
+    segs = oscillation_segments(f_c, amp, period, cycles, f_d)
+    row = {"kind": "oscillate", "center_hz": f_c, "amplitude_hz": amp, "period_s": period, "cycles": cycles,
+           "f_hold_hz": f_d, "peak_rate_hz_s": max(8 * amp / period, 2 * abs(f_c + amp - f_d) / (period / 2))}
+    return measure(a, f"osc_c{f_c:g}_A{amp:g}_P{period:g}_n{cycles}_d{f_d:g}_mu{mu:g}", segs, mu, row)
+
+
+def measure(a, name, segs, mu, row):
     out = os.path.join(a.out, name)
     os.makedirs(out, exist_ok=True)
     cfg = os.path.join(out, "config.yaml")
@@ -99,9 +128,7 @@ def run_case(a, kind, f_h, d, mu):
     sd = math.sqrt(sum((x - mean) ** 2 for x in ir) / (n - 1))
     with open(summary) as f:
         wall = json.load(f).get("wall_time_s", float("nan"))
-    peak_rate = 2 * abs(f_h - (30.0 if kind == "down" else 25.0)) / d  # Hz/s at the middle of the approach
-    return {"kind": kind, "f_hold_hz": f_h, "approach_s": d, "approach_peak_hz_s": peak_rate, "mu": mu,
-            "r_lock": rl, "runs": len(rows), "mean": mean, "hw95": 1.96 * sd / math.sqrt(n),
+    return {**row, "mu": mu, "r_lock": rl, "runs": len(rows), "mean": mean, "hw95": 1.96 * sd / math.sqrt(n),
             "mean_over_rlock": mean / rl, "p10_over_rlock": quantile(ir, 0.1) / rl,
             "median_over_rlock": quantile(ir, 0.5) / rl, "p90_over_rlock": quantile(ir, 0.9) / rl,
             "share_at_goal_depth": sum(1 for x in ir if x <= GOAL_FRACTION * rl) / n,
@@ -122,12 +149,20 @@ def main():
     ap.add_argument("--mu", type=float, nargs="+", default=[0.02, 0.03])
     ap.add_argument("--hold", type=float, nargs="+", default=[28.85, 29.0, 29.2])
     ap.add_argument("--approach", type=float, nargs="+", default=[0.25, 0.5, 1, 2, 4, 8, 16, 32])
+    ap.add_argument("--family", choices=["approach", "oscillate"], default="approach")
+    ap.add_argument("--center", type=float, nargs="+", default=[28.9, 29.2, 29.5], help="oscillate: f_c [Hz]")
+    ap.add_argument("--amplitude", type=float, nargs="+", default=[0.2, 0.5, 1.0, 1.5], help="oscillate: A [Hz]")
+    ap.add_argument("--period", type=float, nargs="+", default=[0.5, 1, 2, 4], help="oscillate: P [s]")
+    ap.add_argument("--cycles", type=int, nargs="+", default=[1, 2, 4], help="oscillate: n")
+    ap.add_argument("--dwell", type=float, nargs="+", default=[28.93, 29.0], help="oscillate: f_d [Hz]")
     a = ap.parse_args()
     if a.runs < 2:
         sys.exit(f"--runs {a.runs}: must be >= 2")
     if not os.access(a.abuopt, os.X_OK):
         sys.exit(f"--abuopt {a.abuopt}: not an executable")
     os.makedirs(a.out, exist_ok=True)
+    if a.family == "oscillate":
+        return oscillate(a)
     rows = []
     for mu in a.mu:
         for kind in ("up", "down"):
@@ -185,6 +220,69 @@ def main():
                 f"plot {plots}, {GOAL_FRACTION} with lines lw 2 lc rgb 'black' title 'goal 7.0e-7 = 0.44 r_lock'\n")
     if gp:
         subprocess.run([gp, "stop_depth.gp"], cwd=a.out, capture_output=True)
+
+
+def oscillate(a):
+    for k, v in (("--amplitude", a.amplitude), ("--period", a.period), ("--cycles", a.cycles)):
+        if min(v) <= 0:
+            sys.exit(f"{k} {min(v):g}: must be > 0")
+    rows = []
+    for mu in a.mu:
+        for f_c in a.center:
+            for amp in a.amplitude:
+                for period in a.period:
+                    for n in a.cycles:
+                        for f_d in a.dwell:
+                            r = run_oscillation(a, f_c, amp, period, n, f_d, mu)
+                            rows.append(r)
+                            print(f"osc f_c {f_c:5.2f} A {amp:4.2f} P {period:4.2f} n {n} f_d {f_d:5.2f} mu {mu:.2f}: "
+                                  f"mean {r['mean']:6.2f} = {r['mean_over_rlock']:.3f} r_lock, <= 0.44 r_lock "
+                                  f"{100 * r['share_at_goal_depth']:5.1f} %", flush=True)
+    with open(os.path.join(a.out, "stop_depth_osc.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    lines = [f"# Oscillations through the band ({a.runs} random starts, seed {a.seed}, contact hard)", ""]
+    for mu in a.mu:
+        sub = sorted((r for r in rows if r["mu"] == mu), key=lambda r: r["mean_over_rlock"])
+        means = [r["mean_over_rlock"] for r in sub]
+        lines += [f"mu {mu:g}: {len(sub)} cases, mean / r_lock from {means[0]:.3f} to {means[-1]:.3f} (median "
+                  f"{quantile(means, 0.5):.3f}); the ten deepest:", "",
+                  "| f_c [Hz] | A [Hz] | P [s] | n | f_d [Hz] | peak rate [Hz/s] | mean \\|I_r\\| [95 %] | mean / r_lock | "
+                  "median | p90 | share <= 0.44 r_lock |", "|" + "---|" * 11]
+        for r in sub[:10]:
+            lines.append(f"| {r['center_hz']:g} | {r['amplitude_hz']:g} | {r['period_s']:g} | {r['cycles']} | "
+                         f"{r['f_hold_hz']:g} | {r['peak_rate_hz_s']:.1f} | {r['mean']:.2f} +- {r['hw95']:.2f} | "
+                         f"{r['mean_over_rlock']:.3f} | {r['median_over_rlock']:.3f} | {r['p90_over_rlock']:.3f} | "
+                         f"{100 * r['share_at_goal_depth']:.1f} % |")
+        lines.append("")
+        for key, label in (("center_hz", "f_c"), ("amplitude_hz", "A"), ("period_s", "P"), ("cycles", "n"),
+                           ("f_hold_hz", "f_d")):
+            vals = sorted({r[key] for r in sub})
+            lines.append(f"least mean / r_lock per {label}: " + ", ".join(
+                f"{v:g}: {min(r['mean_over_rlock'] for r in sub if r[key] == v):.3f}" for v in vals))
+        lines.append("")
+    with open(os.path.join(a.out, "stop_depth_osc.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    print("\n".join(lines))
+    gp = shutil.which("gnuplot")
+    with open(os.path.join(a.out, "stop_depth_osc.dat"), "w") as f:
+        for mu in a.mu:
+            f.write(f"# mu {mu}: peak rate, mean / r_lock, cycles\n")
+            for r in rows:
+                if r["mu"] == mu:
+                    f.write(f"{r['peak_rate_hz_s']:.4f} {r['mean_over_rlock']:.4f} {r['cycles']}\n")
+            f.write("\n\n")
+    plots = ", ".join(f"'stop_depth_osc.dat' index {k} using 1:2 with points pt {7 + k} ps 0.8 title 'mu {mu:g}'"
+                      for k, mu in enumerate(a.mu))
+    with open(os.path.join(a.out, "stop_depth_osc.gp"), "w") as f:
+        f.write("set terminal pngcairo size 1000,650 noenhanced\nset output 'stop_depth_osc.png'\nset grid\n"
+                f"set title 'oscillations through the band: mean |I_r| / r_lock(mu) per case ({a.runs} starts, "
+                "contact hard)'\nset logscale x\nset xlabel 'peak rate of the profile after 25 Hz [Hz/s] (log)'\n"
+                "set ylabel 'mean |I_r| / r_lock(mu)'\nset yrange [0:*]\nset key top left\n"
+                f"plot {plots}, {GOAL_FRACTION} with lines lw 2 lc rgb 'black' title 'goal 7.0e-7 = 0.44 r_lock'\n")
+    if gp:
+        subprocess.run([gp, "stop_depth_osc.gp"], cwd=a.out, capture_output=True)
 
 
 if __name__ == "__main__":

@@ -125,8 +125,14 @@ def end_to_end(abuopt, tmp):
         return
     s = json.load(open(os.path.join(out, "summary.json")))
     check(s["contact"] == "hard", "summary.json records contact hard")
-    check(len(s["table"]) == 16 and all(row["ideal"]["ok"] == 8 for row in s["table"].values()),
-          f"{len(s['table'])} designs validated, every run ok")
+    f3_aimed = {f"{n}_from_{start}" for n in ("f3_mu03", "f3_robust_k6") for start in ("global", "k6")}
+    n_expected = 20  # 16 + the four aimed formulation-3 designs
+    check(len(s["table"]) == n_expected and f3_aimed <= set(s["table"])
+          and all(row["ideal"]["ok"] == 8 and row["s9002"]["ok"] == 8 for row in s["table"].values()),
+          f"{len(s['table'])} designs validated on seeds 9001 and 9002, every run ok")
+    check(all(("mu0.03_s9002" in row) == (n in f3_aimed or n in ("report_2003", "f3_robust"))
+              for n, row in s["table"].items()),
+          "the formulation-3 designs and the 2003 profile also at mu 0.03 on seed 9002")
     check(all(f"{nb}_{n}" in s["balls"] for nb in range(2, 7) for n in ("report_2003", "reoptimised", "f1_design"))
           and all(int(k.split("_")[0]) in range(2, 7) for k in s["balls"]),
           "formulation 4: 2..6 balls, re-optimised, f1 design and 2003 each")
