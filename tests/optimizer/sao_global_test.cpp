@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <memory>
 #include <set>
 #include <string>
 #include <utility>
@@ -16,6 +17,7 @@
 #include "abuopt/optimizer/benchmarking.hpp"
 #include "abuopt/optimizer/benchmarks/benchmark_factory.hpp"
 #include "abuopt/optimizer/sao.hpp"
+#include "two_basins.hpp"
 
 namespace {
 
@@ -28,24 +30,8 @@ opt::SaoOptions with_global(int points, int iterations) {
   return s;
 }
 
-// Two basins: a shallow one at (0.2, 0.2) (f = -1) around the start and a deeper one at (0.8, 0.7)
-// (f = -2), both inside the constraint x + y <= 1.6; the global optimum is the deep one.
-std::unique_ptr<opt::FunctionProblem> two_basins() {
-  auto p = std::make_unique<opt::FunctionProblem>(
-      "two_basins", std::vector<opt::Variable>{{"x", 0, 1, 1}, {"y", 0, 1, 1}},
-      [](const std::vector<double>& x) {
-        auto bump = [&](double cx, double cy) {
-          return std::exp(-((x[0] - cx) * (x[0] - cx) + (x[1] - cy) * (x[1] - cy)) / 0.02);
-        };
-        opt::Evaluation e;
-        e.objective = -bump(0.2, 0.2) - 2 * bump(0.8, 0.7);
-        e.inequality = {x[0] + x[1] - 1.6};
-        return e;
-      },
-      std::vector<std::string>{"sum"});
-  p->set_initial_point({0.25, 0.15});
-  return p;
-}
+// Two basins (two_basins.hpp), declared deterministic: the global phase is asked for explicitly.
+std::unique_ptr<opt::FunctionProblem> two_basins() { return std::make_unique<test::TwoBasins>(false); }
 
 // From a start in the shallow basin the trust region alone ends there; with the global phase the
 // design and the infill find the deep basin and the trust region converges in it.
