@@ -47,6 +47,8 @@ def variant(text, method, band):
         out.append(l)
         if s == "abu:" and not has_contact:
             out.append("  ball_contact: hard")
+    if not any(l.strip() == "method: " + method for l in out):
+        raise ValueError("the config has no simulation.method line to set to " + method)
     return "\n".join(out) + "\n"
 
 
