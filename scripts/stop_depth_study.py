@@ -138,6 +138,16 @@ def measure(a, name, segs, mu, row):
             "wall_s": wall}
 
 
+def write_plot(out, name, body):
+    """Write OUT/NAME.gp (the common preamble: a 1000 x 650 PNG OUT/NAME.png, grid) followed by body, and run
+    gnuplot on it in OUT if gnuplot is installed (the data files body names are relative to OUT)."""
+    with open(os.path.join(out, name + ".gp"), "w") as f:
+        f.write(f"set terminal pngcairo size 1000,650 noenhanced\nset output '{name}.png'\nset grid\n" + body)
+    gp = shutil.which("gnuplot")
+    if gp:
+        subprocess.run([gp, name + ".gp"], cwd=out, capture_output=True)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", default=os.path.join("results", "stop_depth"))
@@ -195,7 +205,6 @@ def main():
         f.write("\n".join(lines) + "\n")
     print("\n".join(lines[-1:]))
     # Plot: mean |I_r| / r_lock (p10..p90 bars) against the approach duration, per case.
-    gp = shutil.which("gnuplot")
     dat = os.path.join(a.out, "stop_depth.dat")
     series = []
     with open(dat, "w") as f:
@@ -211,15 +220,11 @@ def main():
                     series.append(f"{kind} to {f_h:g} Hz, mu {mu:g}")
     plots = ", ".join(f"'stop_depth.dat' index {k} using 1:2 with linespoints lw 1.5 dt {1 if 'up' in s else 2} "
                       f"pt {k % 13 + 1} title '{s}'" for k, s in enumerate(series))
-    gpf = os.path.join(a.out, "stop_depth.gp")
-    with open(gpf, "w") as f:
-        f.write("set terminal pngcairo size 1000,650 noenhanced\nset output 'stop_depth.png'\nset grid\n"
-                f"set title 'mean |I_r| / r_lock(mu) against the approach duration ({a.runs} starts, contact hard)'\n"
-                "set xrange [0.2:40]\nset xlabel 'approach duration D to the hold frequency [s] (log)'\nset logscale x\n"
-                "set ylabel 'mean |I_r| / r_lock(mu)'\nset yrange [0:1.4]\nset key outside right\n"
-                f"plot {plots}, {GOAL_FRACTION} with lines lw 2 lc rgb 'black' title 'goal 7.0e-7 = 0.44 r_lock'\n")
-    if gp:
-        subprocess.run([gp, "stop_depth.gp"], cwd=a.out, capture_output=True)
+    write_plot(a.out, "stop_depth",
+               f"set title 'mean |I_r| / r_lock(mu) against the approach duration ({a.runs} starts, contact hard)'\n"
+               "set xrange [0.2:40]\nset xlabel 'approach duration D to the hold frequency [s] (log)'\nset logscale x\n"
+               "set ylabel 'mean |I_r| / r_lock(mu)'\nset yrange [0:1.4]\nset key outside right\n"
+               f"plot {plots}, {GOAL_FRACTION} with lines lw 2 lc rgb 'black' title 'goal 7.0e-7 = 0.44 r_lock'\n")
 
 
 def oscillate(a):
@@ -265,7 +270,6 @@ def oscillate(a):
     with open(os.path.join(a.out, "stop_depth_osc.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print("\n".join(lines))
-    gp = shutil.which("gnuplot")
     with open(os.path.join(a.out, "stop_depth_osc.dat"), "w") as f:
         for mu in a.mu:
             f.write(f"# mu {mu}: peak rate, mean / r_lock, cycles\n")
@@ -275,14 +279,11 @@ def oscillate(a):
             f.write("\n\n")
     plots = ", ".join(f"'stop_depth_osc.dat' index {k} using 1:2 with points pt {7 + k} ps 0.8 title 'mu {mu:g}'"
                       for k, mu in enumerate(a.mu))
-    with open(os.path.join(a.out, "stop_depth_osc.gp"), "w") as f:
-        f.write("set terminal pngcairo size 1000,650 noenhanced\nset output 'stop_depth_osc.png'\nset grid\n"
-                f"set title 'oscillations through the band: mean |I_r| / r_lock(mu) per case ({a.runs} starts, "
-                "contact hard)'\nset logscale x\nset xlabel 'peak rate of the profile after 25 Hz [Hz/s] (log)'\n"
-                "set ylabel 'mean |I_r| / r_lock(mu)'\nset yrange [0:*]\nset key top left\n"
-                f"plot {plots}, {GOAL_FRACTION} with lines lw 2 lc rgb 'black' title 'goal 7.0e-7 = 0.44 r_lock'\n")
-    if gp:
-        subprocess.run([gp, "stop_depth_osc.gp"], cwd=a.out, capture_output=True)
+    write_plot(a.out, "stop_depth_osc",
+               f"set title 'oscillations through the band: mean |I_r| / r_lock(mu) per case ({a.runs} starts, "
+               "contact hard)'\nset logscale x\nset xlabel 'peak rate of the profile after 25 Hz [Hz/s] (log)'\n"
+               "set ylabel 'mean |I_r| / r_lock(mu)'\nset yrange [0:*]\nset key top left\n"
+               f"plot {plots}, {GOAL_FRACTION} with lines lw 2 lc rgb 'black' title 'goal 7.0e-7 = 0.44 r_lock'\n")
 
 
 if __name__ == "__main__":
