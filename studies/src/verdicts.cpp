@@ -17,15 +17,22 @@ bool mean_clearly_lower(const CaseSummary& a, const CaseSummary& b) {
   return b.mean_x - a.mean_x > kZ95 * std::hypot(a.sem_x, b.sem_x);
 }
 
-// The rows with a value, smallest and largest value.
-std::optional<std::pair<const CaseSummary*, const CaseSummary*>> value_extremes(const std::vector<CaseSummary>& rows) {
+// The rows with a value, smallest and largest value. Sets v's table; without two such rows marks v
+// not tested (the caller returns it) and gives nullopt.
+std::optional<std::pair<const CaseSummary*, const CaseSummary*>> value_extremes(const std::vector<CaseSummary>& rows,
+                                                                                Verdict& v) {
+  if (!rows.empty()) v.table_id = rows.front().table_id;
   const CaseSummary *lo = nullptr, *hi = nullptr;
   for (const CaseSummary& r : rows) {
     if (!r.value || r.ok == 0) continue;
     if (!lo || *r.value < *lo->value) lo = &r;
     if (!hi || *r.value > *hi->value) hi = &r;
   }
-  if (!lo || lo == hi) return std::nullopt;
+  if (!lo || lo == hi) {
+    v.outcome = VerdictOutcome::NotTested;
+    v.evidence = "needs two cases with different values";
+    return std::nullopt;
+  }
   return std::make_pair(lo, hi);
 }
 
@@ -141,13 +148,8 @@ Verdict check_beats_all(const CaseSummary& best, const std::vector<CaseSummary>&
 
 Verdict check_pct_mi_decreases(const std::vector<CaseSummary>& rows) {
   Verdict v;
-  if (!rows.empty()) v.table_id = rows.front().table_id;
-  const auto ext = value_extremes(rows);
-  if (!ext) {
-    v.outcome = VerdictOutcome::NotTested;
-    v.evidence = "needs two cases with different values";
-    return v;
-  }
+  const auto ext = value_extremes(rows, v);
+  if (!ext) return v;
   const CaseSummary& fast = *ext->first;  // smallest duration
   const CaseSummary& slow = *ext->second;
   v.outcome = mi_clearly_lower(slow, fast)     ? VerdictOutcome::Confirmed
@@ -160,13 +162,8 @@ Verdict check_pct_mi_decreases(const std::vector<CaseSummary>& rows) {
 
 Verdict check_worsens_with_value(const std::vector<CaseSummary>& rows) {
   Verdict v;
-  if (!rows.empty()) v.table_id = rows.front().table_id;
-  const auto ext = value_extremes(rows);
-  if (!ext) {
-    v.outcome = VerdictOutcome::NotTested;
-    v.evidence = "needs two cases with different values";
-    return v;
-  }
+  const auto ext = value_extremes(rows, v);
+  if (!ext) return v;
   const CaseSummary& lo = *ext->first;
   const CaseSummary& hi = *ext->second;
   const bool up = hi.mean_x > lo.mean_x && hi.pct_mi_x > lo.pct_mi_x;
