@@ -69,10 +69,31 @@ void contact_setup(RunState& rs, const double* y) {
   cs.v_stop = 1e-3 / (rs.params.ball_track_radius_m * rs.omega_n);
 }
 
+void switch_contact_modes(RunState& rs, double W, double Wp, const double* y) {
+  ContactState& cs = rs.cs;
+  rs.switch_y.assign(y, y + rs.lay().size());
+  rs.switch_forced.assign(rs.n, 0);
+  rs.switch_closed = cs.closed;
+  choose_contact_modes(rs, W, Wp, rs.switch_y, rs.switch_forced, run_contact_choice(), rs.opt.switch_band);
+  for (std::size_t k = 0; k < cs.geo.pairs(); ++k) {
+    if (!rs.switch_closed[k] || cs.closed[k]) continue;
+    const double gk = cs.geo.gap(y + rs.lay().beta(0), k);
+    cs.off_gap[k] = gk < kGapOffset ? kGapOffset - gk : 0.0;
+  }
+}
+
 void roots_contact(double tbar, const double* y, double* g, void* user) {
   auto& rs = *static_cast<RunState*>(user);
   const StateLayout& lay = rs.lay();
   const ContactState& cs = rs.cs;
+  if (switch_model(rs)) {
+    // the switch model's events: gaps closing only (stick, slip and separation are chosen at
+    // every right-hand-side call)
+    std::fill(g, g + 2 * rs.n, 1.0);
+    for (std::size_t k = 0; k < cs.geo.pairs(); ++k)
+      g[2 * rs.n + k] = cs.closed[k] ? 1.0 : cs.geo.gap(y + lay.beta(0), k) + cs.off_gap[k];
+    return;
+  }
   evaluate_forces(rs, tbar, y);
   for (const auto& grp : cs.clusters.groups) {
     const BallMode mode = rs.modes[grp.front()];
@@ -97,9 +118,11 @@ void root_rates_contact(double, const double* y, double* gd, void* user) {
   const StateLayout& lay = rs.lay();
   const ContactState& cs = rs.cs;
   std::fill(gd, gd + 2 * rs.n, 0.0);
+  // the angles' rates: the speeds, but zero for a ball the switch model holds stuck
+  const bool sw = switch_model(rs);
+  auto rate = [&](std::size_t i) { return sw && rs.modes[i] == BallMode::Stick ? 0.0 : y[lay.beta_dot(i)]; };
   for (std::size_t k = 0; k < cs.geo.pairs(); ++k)
-    gd[2 * rs.n + k] = cs.closed[k] ? 0.0
-                                    : y[lay.beta_dot(cs.geo.order[(k + 1) % rs.n])] - y[lay.beta_dot(cs.geo.order[k])];
+    gd[2 * rs.n + k] = cs.closed[k] ? 0.0 : rate(cs.geo.order[(k + 1) % rs.n]) - rate(cs.geo.order[k]);
 }
 
 // Functions that start at or below zero by rounding are shifted so their later crossing is seen.
@@ -132,6 +155,19 @@ int handle_contact_event(RunState& rs, double tbar, std::vector<double>& y, cons
   ContactState& cs = rs.cs;
   const StateLayout& lay = rs.lay();
   const std::size_t n = rs.n;
+  const bool sw = switch_model(rs);
+  if (sw) {
+    // Switch model: the clusters and modes at the event's state; a stuck ball does not move
+    // (its angle is frozen), so the impact sees it at zero speed, and a cluster at its mean speed.
+    const Speed s = rs.pi_motor ? evaluate_forces(rs, tbar, y.data()) : ideal_speed(rs, tbar);
+    switch_contact_modes(rs, s.W, s.Wp, y.data());
+    for (const auto& g : cs.clusters.groups) {
+      double v = 0;
+      for (std::size_t i : g) v += y[lay.beta_dot(i)];
+      v = rs.modes[g.front()] == BallMode::Stick ? 0.0 : v / static_cast<double>(g.size());
+      for (std::size_t i : g) y[lay.beta_dot(i)] = v;
+    }
+  }
   const Speed sp0 = evaluate_forces(rs, tbar, y.data());
   const std::vector<std::vector<std::size_t>> old_groups = cs.clusters.groups;
   const std::vector<BallMode> old_modes = rs.modes;
@@ -202,7 +238,8 @@ int handle_contact_event(RunState& rs, double tbar, std::vector<double>& y, cons
     cs.max_correction = std::max(cs.max_correction, -gk);
   }
   const Speed sp = rs.pi_motor ? sp0 : ideal_speed(rs, tbar);
-  choose_contact_modes(rs, sp.W, sp.Wp, y, forced);
+  // the switch model chooses with its band (balls chosen stuck get zero speed, as at its impacts)
+  choose_contact_modes(rs, sp.W, sp.Wp, y, forced, run_contact_choice(), sw ? rs.opt.switch_band : 0.0);
   return impacts;
 }
 

@@ -35,8 +35,8 @@ struct Violation {
 
 class ModeChoice {
  public:
-  ModeChoice(RunState& rs, double W, double Wp, std::vector<double>& y, const std::vector<char>& forced)
-      : rs_(rs), cs_(rs.cs), lay_(rs.lay()), W_(W), Wp_(Wp), y_(y), forced_(forced) {
+  ModeChoice(RunState& rs, double W, double Wp, std::vector<double>& y, const std::vector<char>& forced, double band)
+      : rs_(rs), cs_(rs.cs), lay_(rs.lay()), W_(W), Wp_(Wp), y_(y), forced_(forced), band_(band) {
     const std::size_t n = rs.n, K = cs_.geo.pairs();
     pos_of_.assign(n, 0);
     for (std::size_t k = 0; k < K; ++k) pos_of_[cs_.geo.order[k]] = k;
@@ -88,11 +88,14 @@ class ModeChoice {
 
  private:
   void evaluate() { rs_.model.evaluate_clusters(y_.data(), W_, Wp_, rs_.modes.data(), cs_.clusters, rs_.mu, rs_.forces); }
-  // zero speed: each part sticks, slips forward or back; moving: the sign of the speed
-  static std::size_t part_options(const Touch& tc, std::size_t mask) {
+  // At rest: zero speed (event-driven), or within the switch model's band |v| <= switch_band
+  // (docs/model.md 8.1); with band 0 the test is v == 0.
+  bool at_rest(double v) const { return std::fabs(v) <= band_; }
+  // at rest: each part sticks, slips forward or back; moving: the sign of the speed
+  std::size_t part_options(const Touch& tc, std::size_t mask) const {
     const std::size_t parts = 1 + static_cast<std::size_t>(__builtin_popcountll(mask));
     std::size_t m = 1;
-    if (tc.v == 0.0)
+    if (at_rest(tc.v))
       for (std::size_t p = 0; p < parts; ++p) m *= 3;
     return m;
   }
@@ -114,6 +117,7 @@ class ModeChoice {
   double W_, Wp_;
   std::vector<double>& y_;
   const std::vector<char>& forced_;
+  double band_;
   std::vector<std::size_t> pos_of_;  // ball -> its place in the cyclic order (the pair after it)
   std::vector<char> link_;
   std::vector<Touch> touch_;
@@ -127,7 +131,7 @@ void ModeChoice::decode(const Touch& tc, std::size_t code, std::size_t& mask, st
     const std::size_t m = part_options(tc, mask);
     if (code < m) {
       part_modes.assign(parts, tc.v > 0 ? BallMode::SlipForward : BallMode::SlipBackward);
-      if (tc.v == 0.0)
+      if (at_rest(tc.v))
         for (std::size_t p = 0; p < parts; ++p, code /= 3)
           part_modes[p] = code % 3 == 0 ? BallMode::Stick : (code % 3 == 1 ? BallMode::SlipForward : BallMode::SlipBackward);
       return;
@@ -203,7 +207,7 @@ double ModeChoice::violation(Violation* worst) {
       for (std::size_t i : grp) dirs = static_cast<char>(dirs | forced_[i]);
       const bool was_forced = (dirs & (mode == BallMode::SlipForward ? kForcedForward : kForcedBackward)) != 0;
       const double acc_scale = scale / rs.nd.mbar[grp.front()];
-      if (v == 0.0 && !(acc > 0) && !was_forced) {
+      if (at_rest(v) && !(acc > 0) && !was_forced) {
         viol += 1.0 + std::fabs(acc) / acc_scale;
         note(Violation::WrongAccel, 1.0 + std::fabs(acc) / acc_scale, g, 0, 0);
       }
@@ -244,7 +248,7 @@ bool ModeChoice::enumerate() {
   if (total > 20000) {
     total = 1;
     for (std::size_t t = 0; t < touch_.size(); ++t) {
-      radix[t] = touch_[t].v == 0.0 ? 3 : 1;
+      radix[t] = at_rest(touch_[t].v) ? 3 : 1;
       total = total > 100000 ? total : total * radix[t];
     }
   }
@@ -371,11 +375,11 @@ bool ModeChoice::pivot(int& pivots) {
   for (std::size_t k = 0; k < link_.size(); ++k) cs_.closed[k] = link_[k];
   for (const Touch& tc : touch_)
     for (std::size_t i : tc.balls)
-      rs_.modes[i] = tc.v == 0.0 ? BallMode::Stick : (tc.v > 0 ? BallMode::SlipForward : BallMode::SlipBackward);
+      rs_.modes[i] = at_rest(tc.v) ? BallMode::Stick : (tc.v > 0 ? BallMode::SlipForward : BallMode::SlipBackward);
   build_clusters(rs_);
   pivots = 0;
   for (std::size_t t = 0; t < touch_.size(); ++t)
-    if (touch_[t].forced && touch_[t].v == 0.0) {
+    if (touch_[t].forced && at_rest(touch_[t].v)) {
       release_forced(t);
       ++pivots;
     }
@@ -410,21 +414,21 @@ ContactChoiceMethod& run_contact_choice() {
 }
 
 ContactChoiceResult choose_contact_modes(RunState& rs, double W, double Wp, std::vector<double>& y,
-                                         const std::vector<char>& forced, ContactChoiceMethod method) {
+                                         const std::vector<char>& forced, ContactChoiceMethod method, double band) {
   SimCounters& cnt = sim_counters();
   if (method == ContactChoiceMethod::Compare) {
     // the enumeration on a copy, then Auto on this state
     RunState ref = rs;
     std::vector<double> yref = y;
     const long choices = cnt.mode_choices;
-    const ContactChoiceResult e = choose_contact_modes(ref, W, Wp, yref, forced, ContactChoiceMethod::Enumerate);
+    const ContactChoiceResult e = choose_contact_modes(ref, W, Wp, yref, forced, ContactChoiceMethod::Enumerate, band);
     cnt.mode_choices = choices;
-    const ContactChoiceResult res = choose_contact_modes(rs, W, Wp, y, forced, ContactChoiceMethod::Auto);
+    const ContactChoiceResult res = choose_contact_modes(rs, W, Wp, y, forced, ContactChoiceMethod::Auto, band);
     cnt.mode_differs += ref.modes != rs.modes || ref.cs.closed != rs.cs.closed;
     cnt.mode_enum_consistent += e.consistent;
     return res;
   }
-  ModeChoice mc(rs, W, Wp, y, forced);
+  ModeChoice mc(rs, W, Wp, y, forced, band);
   ContactChoiceResult res;
   ++cnt.mode_choices;
   if (method != ContactChoiceMethod::Enumerate) {

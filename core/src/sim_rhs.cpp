@@ -46,10 +46,19 @@ Speed evaluate_forces(RunState& rs, double tbar, const double* y) {
 // Switch model (Leine): a ball with |beta'| below the band is a stick candidate; modes are chosen
 // at every right-hand-side call. A stuck ball's angle is frozen (the report reset beta' = 0 every
 // step to the same effect).
+// With hard contact (docs/model.md 8.1) the same rule per cluster: the joint choice of clusters
+// and modes of an event (choose_contact_modes) with clusters at |speed| <= band counting as at
+// rest, on a copy of the state (the choice equalises the speeds of touching balls and zeroes
+// those of stuck ones; the right-hand side keeps the state as it is, as without contact). The
+// clusters it chooses persist like the modes: a cut made here is the switch model's separation.
 void switch_modes(RunState& rs, double tbar, const double* y) {
   // The PI motor's W' depends on the modes through the friction feedback: the W' of the current
   // modes is used to choose the new ones.
   const Speed sp = rs.pi_motor ? evaluate_forces(rs, tbar, y) : ideal_speed(rs, tbar);
+  if (rs.contact) {
+    switch_contact_modes(rs, sp.W, sp.Wp, y);
+    return;
+  }
   rs.model.choose_modes(y, sp.W, sp.Wp, rs.mu, rs.opt.switch_band, rs.modes.data(), rs.forces);
 }
 
@@ -83,6 +92,17 @@ void rhs_plain(double tbar, const double* y, double* yd, void* user) {
     const bool frozen = rs.modes[i] == BallMode::Stick;
     yd[lay.beta(i)] = frozen ? 0.0 : y[lay.beta_dot(i)];
     yd[lay.beta_dot(i)] = rs.forces.betadd[i];
+  }
+  if (rs.contact && switch_model(rs)) {
+    // The balls of a cluster move as one: their angles at the cluster's mean speed (the speeds
+    // of balls joined by the switch choice agree only to 1e-9; events make them equal exactly).
+    for (const auto& g : rs.cs.clusters.groups) {
+      if (g.size() < 2 || rs.modes[g.front()] == BallMode::Stick) continue;
+      double v = 0;
+      for (std::size_t i : g) v += y[lay.beta_dot(i)];
+      v /= static_cast<double>(g.size());
+      for (std::size_t i : g) yd[lay.beta(i)] = v;
+    }
   }
   if (rs.pi_motor) {
     const double W_ref = kTwoPi * reference_hz(rs, tbar) / rs.omega_n;

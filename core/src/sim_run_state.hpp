@@ -62,6 +62,10 @@ struct RunState {
   double ref_hold_hz = 0;
   bool contact = false;  // hard ball-ball contact (two or more balls)
   ContactState cs;
+  // switch model with contact: the choice of each right-hand-side call works on a copy of the
+  // state (scratch, kept to avoid allocations) and with no forced clusters
+  std::vector<double> switch_y;
+  std::vector<char> switch_forced, switch_closed;
 
   const StateLayout& lay() const { return model.layout(); }
   // Root functions: two per ball; with contact one more per neighbour pair (the gaps).
@@ -105,8 +109,10 @@ inline double reference_hz(const RunState& rs, double tbar) {
 
 // Evaluates forces for the current modes into rs.forces and returns the speed used (sim_rhs.cpp).
 Speed evaluate_forces(RunState& rs, double tbar, const double* y);
-// Switch model: chooses the modes at every right-hand-side call.
+// Switch model: chooses the modes (with contact: and the clusters) at every right-hand-side call.
 void switch_modes(RunState& rs, double tbar, const double* y);
+// True for the switch model (simulation.method: switch_model).
+inline bool switch_model(const RunState& rs) { return rs.opt.method == FrictionMethod::SwitchModel; }
 // Right-hand side and root functions with the native stepper's signatures.
 void rhs_plain(double tbar, const double* y, double* yd, void* user);
 void roots_plain(double tbar, const double* y, double* g, void* user);
@@ -139,9 +145,15 @@ struct ContactChoiceResult {
 // The method of the simulator's runs on this thread (Auto; tests and benchmarks compare it with
 // Enumerate, the choice before pivoting).
 ContactChoiceMethod& run_contact_choice();
+// band: clusters with |speed| <= band count as at rest (may stick); 0 for the event-driven
+// model, simulation.switch_band for the switch model (docs/model.md 8.1).
 ContactChoiceResult choose_contact_modes(RunState& rs, double W, double Wp, std::vector<double>& y,
                                          const std::vector<char>& forced,
-                                         ContactChoiceMethod method = run_contact_choice());
+                                         ContactChoiceMethod method = run_contact_choice(), double band = 0.0);
+// Switch model with contact (docs/model.md 8.1): the clusters and modes of one right-hand-side
+// call, chosen on a copy of y with clusters at |speed| <= switch_band at rest; a contact it cuts
+// gets its gap's root offset (the gap starts at zero).
+void switch_contact_modes(RunState& rs, double W, double Wp, const double* y);
 // Applies the roots found at an event: impacts for closing gaps, zero speed for clusters that
 // stopped; then choose_contact_modes. Returns the number of impacts.
 int handle_contact_event(RunState& rs, double tbar, std::vector<double>& y, const std::vector<int>& rinfo);

@@ -65,9 +65,6 @@ Simulator::Simulator(SimulationSetup setup) : setup_(std::move(setup)) {
   if (end_time_s() <= 0)
     throw ConfigError("simulation.end_time_s", std::to_string(o.end_time_s),
                       "must be > 0 when the profile has no segments");
-  if (setup_.abu.ball_contact == BallContact::Hard && o.method != FrictionMethod::EventDriven)
-    throw ConfigError("abu.ball_contact", "hard",
-                      "needs simulation.method = event_driven (the switch model has no contact events)");
   // The exact stuck-phase propagator: its forcing integrals depend only on the profile and the
   // table, so they are computed once here and shared by every run.
   const NondimParameters nd = NondimParameters::from(setup_.abu);
@@ -320,7 +317,8 @@ bool Run::count_event(double t) {
 }
 
 RunOutcome Run::execute() {
-  std::unique_ptr<Integrator> integ_ptr = make_integrator(rs_, nvar_, event_driven_);
+  // root functions: the event-driven model's, or the switch model's gap closings with contact
+  std::unique_ptr<Integrator> integ_ptr = make_integrator(rs_, nvar_, event_driven_ || rs_.contact);
   Integrator& integ = *integ_ptr;
   std::vector<double>& y = y_;
   double t = 0;
