@@ -21,11 +21,14 @@ kept; rerun the same command after an interruption):
      no worse than the 2003 profile's on the same 256 starts (constraints max_mean_abs_ir, max_pct_mi),
      one COBYLA optimisation from each of several starts (the front's 6, 8 and 11 s designs and the
      19 s sweep design scaled to 8 s); the least feasible T over the starts
+  3b. formulation 2 with the PI motor in the loop: the same least-T problem with `motor: pi`, bounded by the
+     2003 profile's figures under the PI motor; from the ideal-motor design and the front's 8 and 11 s designs
   4. formulation 3: robust over mu {0.02, 0.03, 0.04} and the imbalance +-20 %, from the best 19 s design
-     of the sweep family; then, aimed at the robust goal, the k6_sweep family with the objective at
-     mu = 0.03 (configs/studies/f3_mu03.yaml) and, for comparison, over the spread
-     (f3_robust_k6.yaml): each a global phase (DIRECT_L, L1 penalty) and two polishes (COBYLA, from the
-     global best and from formulation 1's k6_sweep design)
+     of the sweep family; then, aimed at the robust goal, the objective at mu = 0.03 over the k6_sweep
+     (configs/studies/f3_mu03.yaml), k4_hold (f3_mu03_k4.yaml) and release (f3_mu03_release.yaml) families
+     and, for comparison, k6_sweep over the spread (f3_robust_k6.yaml): each a global phase (DIRECT_L, L1
+     penalty) and two polishes (COBYLA, from the global best and from formulation 1's design of the family;
+     release: from the deepest case of the release scan)
   5. formulation 4: the k4_hold family and the best 19 s design's family re-optimised per ball count
      (2..6 balls of equal total mass);
      the best 19 s design re-optimised with the PI motor and the drive's 1 Hz setpoints (f1_quantised)
@@ -34,6 +37,9 @@ kept; rerun the same command after an interruption):
      every design again on a second fresh set (seed 9002), the formulation-3 designs also at mu 0.03;
      the ball-count designs beside the 2003 profile with the same balls
   7. summary.md, summary.json, best/*.yaml (ready to run), plots (profiles, front, final positions)
+  8. the stop-depth families of the limit analysis (scripts/stop_depth_study.py: approach, oscillate,
+     release) into OUT/stop_depth_*: --stop-depth quick (default: a subset with the published deepest
+     cases), full (the published grids of section 8.1, about 35 min of one core more) or none
 
 One progress line per evaluation, with the stage's and the study's ETA; at the end of every stage its
 wall time and the CPU time of its abuopt processes (summary.json "stage_cost": the idle-machine wall
@@ -438,6 +444,10 @@ def main():
                     help="formulation 1's bound on %%MI(|I_r|) (default 2, the goal, without contact; 4 with contact: "
                          "half the 2003 profile's %%MI under contact, see the document's section 8)")
     ap.add_argument("--skip-balls", action="store_true", help="skip formulation 4 (ball count)")
+    ap.add_argument("--stop-depth", choices=["quick", "full", "none"], default="quick",
+                    help="stage 8, the stop-depth families of the limit analysis (scripts/stop_depth_study.py): quick "
+                         "(default, a subset with the published deepest cases, about 3 min of one core), full (the "
+                         "published grids, about 35 min of one core), none")
     a = ap.parse_args()
     if a.out is None:
         a.out = os.path.join("results", "startup_study_contact" if a.contact == "hard" else "startup_study")
@@ -466,17 +476,23 @@ def main():
     # polish starts) per objective; the spread objective costs 3 Monte Carlos per evaluation.
     f3_budget = {"f3_mu03": (max(2, int(300 * sc)), max(4, int(128 * sc)), max(2, int(120 * sc)), max(4, int(512 * sc))),
                  "f3_robust_k6": (max(2, int(200 * sc)), max(4, int(64 * sc)), max(2, int(100 * sc)),
-                                  max(4, int(192 * sc)))}
+                                  max(4, int(192 * sc))),
+                 # the same objective at mu = 0.03 over two more families: k4_hold (the best 19 s design's) and the
+                 # release of section 8.1 (dwell at f1, step to f2, dwell)
+                 "f3_mu03_k4": (max(2, int(200 * sc)), max(4, int(128 * sc)), max(2, int(80 * sc)), max(4, int(512 * sc))),
+                 "f3_mu03_release": (max(2, int(200 * sc)), max(4, int(128 * sc)), max(2, int(80 * sc)),
+                                     max(4, int(512 * sc)))}
     g_runs, p_runs, front_runs, robust_runs = (max(4, int(64 * sc)), max(4, int(256 * sc)),
                                                max(4, int(128 * sc)), max(4, int(96 * sc)))
     f2_evals, f2_runs = max(2, int(40 * sc)), max(4, int(256 * sc))
     q_evals, q_runs = max(2, int(40 * sc)), max(4, int(128 * sc))  # PI + 1 Hz runs cost about 5 ideal-motor runs
     f2_starts = 4  # the front's 6, 8 and 11 s designs and the 19 s sweep design scaled to 8 s
+    f2p_starts_n = 3  # with the PI motor: the ideal-motor design and the front's 8 and 11 s designs
     val_runs, switch_runs = a.val_runs, min(256, a.val_runs)
     counts = [] if a.skip_balls else list(range(2, 7))
-    n_designs = len(FAMILIES) + 1 + len(FRONT_T) + 1 + 1 + 1 + 1
+    n_designs = len(FAMILIES) + 1 + len(FRONT_T) + 1 + 1 + 1 + 1 + 1
     st.evals_total = (len(FAMILIES) * (g_evals + p_evals) + p_evals + len(FRONT_T) * front_evals + 1 +
-                      f2_starts * f2_evals + robust_evals + 2 * len(counts) * p_evals + q_evals
+                      (f2_starts + f2p_starts_n) * f2_evals + 1 + robust_evals + 2 * len(counts) * p_evals + q_evals
                       + sum(g + 2 * p for g, _, p, _ in f3_budget.values()))
     n_designs += 2 * len(f3_budget)
     st.runs_total = ((n_designs + 1) * val_runs * 4 + 6 * (val_runs * 2 + (switch_runs * 2 if contact == "none" else 0))
@@ -548,6 +564,32 @@ def main():
     designs["f2_min_T"] = {"result": f2_best, "formulation": 2, "T": f2_best["best"]["metrics"]["startup_time_s"],
                            "steps": f2_log, "ref": {"mean": m03, "pct_mi": p03, "runs": f2_runs}}
 
+    # 3b. Formulation 2 with the drive in the loop: the same problem with `motor: pi` in the optimised
+    # config, its bounds the 2003 profile's mean |I_r| and %MI under the PI motor on the same starts. The
+    # ideal-motor design of 3 loses to the 2003 profile with the PI motor (section 8.3), so the least T for
+    # the real drive must be searched with the drive. COBYLA from the ideal-motor design and the front's 8
+    # and 11 s designs.
+    st.stage("3b formulation 2 with the PI motor")
+    pi_motor = "motor:\n  kind: pi\n"
+    ref_pi = set_section_value(replace_section(config("f1_k3"), "motor", pi_motor), "runs", f2_runs)
+    r03p = st.optimize("f2_ref2003_pi", ref_pi, 1)["best"]
+    m03p, p03p = r03p["objective"], r03p["metrics"]["pct_mi"]
+    st.log(f"[f2 pi] the 2003 profile with the PI motor on the {f2_runs} design starts: mean |I_r| {m03p:.3f}, "
+           f"%MI {p03p:.2f}")
+    f2p_front = replace_section(config("f5_front"), "motor", pi_motor)
+    f2p_starts = [("ideal_f2", designs["f2_min_T"]["result"]["best"]["x"])] if designs["f2_min_T"]["result"]["best"]["x"] \
+        else []
+    f2p_starts += [(f"front{T}", designs[f"f5_T{T}"]["result"]["best"]["x"]) for T in (8, 11)]
+    f2p_best, f2p_log = formulation2(st, f2p_front, f2_runs, m03p, p03p, [(f"pi_{n}", x) for n, x in f2p_starts],
+                                     f2_evals)
+    if f2p_best is None:
+        st.log("[f2 pi] no start reached a profile that meets both with the PI motor; its design is the 2003 profile")
+        f2p_best = {"best": {"objective": 19.0, "feasible": True, "x": {}, "profile": report_profile(),
+                             "metrics": {"startup_time_s": 19.0}}}
+    designs["f2pi_min_T"] = {"result": f2p_best, "formulation": "2pi",
+                              "T": f2p_best["best"]["metrics"]["startup_time_s"], "steps": f2p_log,
+                              "ref": {"mean": m03p, "pct_mi": p03p, "runs": f2_runs}}
+
     # 4. Formulation 3: robust, from the best 19 s design of the sweep family.
     st.stage("4 formulation 3 (robust)")
     rb = set_section_value(config("f3_robust"), "runs", robust_runs)
@@ -559,10 +601,14 @@ def main():
     # polishes, from the global best and from the k6_sweep design. Validated at mu 0.03 on seeds 9001 and 9002
     # (9001 chose the k6 family as the start, so 9002 is the clean out-of-sample check).
     k6_x = designs["f1_k6_sweep"]["result"]["best"]["x"]
+    # the second polish start per objective: formulation 1's design of the family, or (release) the config's x0,
+    # the deepest case of the release scan at mu 0.03
+    second = {"f3_mu03": ("k6", k6_x), "f3_robust_k6": ("k6", k6_x),
+              "f3_mu03_k4": ("k4", designs["f1_k4_hold"]["result"]["best"]["x"]), "f3_mu03_release": ("scan", {})}
     for name, (ge, gr, pe, pr) in f3_budget.items():
         base = set_section_value(config(name), "runs", pr)
         g = st.optimize(name + "_global", global_config(base, gr, ge), ge)
-        for start, x0 in (("global", g["best"]["x"]), ("k6", k6_x)):
+        for start, x0 in (("global", g["best"]["x"]), second[name]):
             r = st.optimize(f"{name}_from_{start}", set_x0(base, x0), pe)
             designs[f"{name}_from_{start}"] = {"result": r, "formulation": 3, "T": 19, "global": g}
 
@@ -604,7 +650,7 @@ def main():
     os.makedirs(best_dir, exist_ok=True)
     table = {}
     # The motor and switch-model checks (the expensive ones) for the designs the document reports in full.
-    heavy = {"report_2003", best19, "f3_robust", "f5_T8", "f2_min_T", "f1_quantised"}
+    heavy = {"report_2003", best19, "f3_robust", "f5_T8", "f2_min_T", "f2pi_min_T", "f1_quantised"}
     val_dir = os.path.join(st.out, "validation")
     for n, prof in profiles.items():
         title = f"startup study design {n}" if n != "report_2003" else "the 2003 report's final profile"
@@ -641,6 +687,9 @@ def main():
     with open(os.path.join(best_dir, "f1_quantised.yaml"), "w") as f:  # ready to run with the motor it was made for
         f.write(run_config(profiles["f1_quantised"], "startup study design f1_quantised (PI motor, 1 Hz setpoints), "
                            f"ball contact {contact}", motor=quantised[len("motor:\n"):], contact=contact))
+    with open(os.path.join(best_dir, "f2pi_min_T.yaml"), "w") as f:  # made with the PI motor: runs with it
+        f.write(run_config(profiles["f2pi_min_T"], f"startup study design f2pi_min_T (formulation 2 with the PI motor), "
+                           f"ball contact {contact}", motor=pi_motor[len("motor:\n"):], contact=contact))
 
     # Formulation 4's designs and the 2003 profile with the same balls, on the same fresh starts.
     balls = {}
@@ -671,6 +720,9 @@ def main():
 
     st.stage("7 summary and plots")
     write_summary(st, designs, table, balls, best19)
+    if a.stop_depth != "none":
+        st.stage(f"8 stop depth ({a.stop_depth})")
+        stop_depth_stage(st, a.stop_depth)
     st.stage(None)
     with open(os.path.join(st.out, "stage_cost.json"), "w") as f:
         json.dump(st.stage_cost, f, indent=1)
@@ -678,6 +730,63 @@ def main():
     st.log(f"[cost] whole study: CPU {fmt_s(total_cpu)} (idle 2-core wall estimate {fmt_s(total_cpu / 2)}); "
            "stage_cost.json")
     st.log(f"done in {fmt_s(time.time() - st.t0)}: {os.path.join(st.out, 'summary.md')}")
+
+# Section 8.1 of the study's document: scripts/stop_depth_study.py, one family at a time. "full" is the published
+# grids (96 approaches of 1024 starts, 576 oscillations and the release scan of 256 starts: about 35 min of one
+# core); "quick" (the default) a subset with the published deepest cases (about 3 min of one core).
+STOP_DEPTH = {
+    "quick": [("approach", ["--runs", "1024", "--hold", "28.85", "29.0", "29.2", "--approach", "0.25", "2", "8", "32"]),
+              ("oscillate", ["--runs", "256", "--center", "29.2", "--amplitude", "0.5", "1", "--period", "2", "4",
+                             "--cycles", "1", "4", "--dwell", "28.93"]),
+              ("release", ["--runs", "256", "--f1", "28.4", "29.45", "--f2", "28.9", "29.0", "--dwell1", "3",
+                           "--approach-s", "3", "0.25", "--step", "0"])],
+    "full": [("approach", ["--runs", "1024"]),
+             ("oscillate", ["--runs", "256"]),
+             ("release", ["--runs", "256", "--f1", "28.4", "29.4", "29.45", "29.5", "29.6", "--dwell1", "3",
+                          "--stairs", "28.0:28.4:28.9", "29.8:29.45:28.9", "30.5:29.45:28.9"]),
+             ("release", ["--runs", "256", "--f1", "29.9", "30.3", "30.6", "--f2", "29.3", "29.5", "29.8", "--dwell1", "3",
+                          "--approach-s", "0.25", "3", "--step", "0"])],
+}
+
+
+def stop_depth_cases(family, args):
+    """The number of cases scripts/stop_depth_study.py runs for these arguments (its defaults otherwise)."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import stop_depth_study as sd
+    ns = sd.parser().parse_args(["--family", family] + args)
+    per_mu = {"approach": 2 * len(ns.hold) * len(ns.approach),
+              "oscillate": len(ns.center) * len(ns.amplitude) * len(ns.period) * len(ns.cycles) * len(ns.dwell),
+              "release": (len(ns.f1) * len(ns.f2) + len(ns.stairs)) * len(ns.approach_s) * len(ns.dwell1) * len(ns.step)}
+    return per_mu[family] * len(ns.mu)
+
+
+def stop_depth_stage(st, which):
+    """Runs the stop-depth families of section 8.1 into OUT/stop_depth_<family>[_k] (resumable: finished cases are
+    kept), one progress line per case with the stage's ETA; --scale multiplies the random starts per case."""
+    script = os.path.join(ROOT, "scripts", "stop_depth_study.py")
+    jobs = STOP_DEPTH[which]
+    total = sum(stop_depth_cases(f, args) for f, args in jobs)
+    done, start = 0, time.time()
+    jobs = [(f, [str(max(4, int(int(v) * st.a.scale))) if i and args[i - 1] == "--runs" else v
+                 for i, v in enumerate(args)]) for f, args in jobs]  # --scale multiplies the starts per case
+    for k, (family, args) in enumerate(jobs):
+        same = [j for j, (f, _) in enumerate(jobs) if f == family]
+        out = os.path.join(st.out, f"stop_depth_{family}" + (f"_{same.index(k) + 1}" if len(same) > 1 else ""))
+        cmd = [sys.executable, script, "--family", family, "--out", out, "--abuopt", st.a.abuopt, "--threads",
+               str(st.a.threads), "--nice", str(st.a.nice)] + args
+        p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        for line in p.stdout:
+            if not re.match(r"^(up|down|osc|release) ", line):
+                continue
+            done += 1
+            left = (time.time() - start) / done * (total - done)
+            st.log(f"[stop depth {family}] case {done}/{total}: {line.strip()}; stage ETA {fmt_s(left)}")
+        err = p.stderr.read()
+        p.wait()
+        if p.returncode != 0:
+            sys.exit(f"scripts/stop_depth_study.py --family {family} failed (status {p.returncode}):\n{err}")
+        st.log(f"[stop depth {family}] {out}: stop_depth*.md, .csv, .png")
+
 
 def write_summary(st, designs, table, balls, best19):
     out = st.out
@@ -725,10 +834,13 @@ def write_summary(st, designs, table, balls, best19):
         b = designs['f1_k3_local2003']['result']['best']
         lines.append(f"- f1_k3 polished from the 2003 profile: {b['objective']:.3f} (feasible {b['feasible']})")
     f2 = designs.get("f2_min_T")
-    if f2:
+    for key, motor in (("f2_min_T", "ideal motor"), ("f2pi_min_T", "PI motor")):
+        if key not in designs:
+            continue
+        f2 = designs[key]
         ref = f2["ref"]
-        lines += ["", f"## Formulation 2: least T with mean |I_r| <= {ref['mean']:.3f} and %MI <= {ref['pct_mi']:.2f} "
-                  f"(the 2003 profile on the same {ref['runs']} starts)", "",
+        lines += ["", f"## Formulation 2 ({motor}): least T with mean |I_r| <= {ref['mean']:.3f} and %MI <= "
+                  f"{ref['pct_mi']:.2f} (the 2003 profile, {motor}, on the same {ref['runs']} starts)", "",
                   "| start | T of the start [s] | T found [s] | mean \\|I_r\\| | %MI | feasible | evaluations |",
                   "|---|---|---|---|---|---|---|"]
         for s in f2["steps"]:
@@ -755,7 +867,9 @@ def write_summary(st, designs, table, balls, best19):
     with open(os.path.join(out, "summary.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     js = {"contact": st.a.contact, "best19": best19, "table": {n: {k: v for k, v in r.items()} for n, r in table.items()},
-          "f2": {k: v for k, v in (f2 or {}).items() if k in ("steps", "ref", "T")}, "stage_cost": st.stage_cost,
+          "f2": {k: v for k, v in designs.get("f2_min_T", {}).items() if k in ("steps", "ref", "T")},
+          "f2_pi": {k: v for k, v in designs.get("f2pi_min_T", {}).items() if k in ("steps", "ref", "T")},
+          "stage_cost": st.stage_cost,
           "balls": {f"{k[0]}_{k[1]}": v for k, v in balls.items()}}
     with open(os.path.join(out, "summary.json"), "w") as f:
         json.dump(js, f, indent=1)

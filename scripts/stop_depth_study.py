@@ -16,6 +16,17 @@ outside the set of another, so they slide again): n cycles of amplitude A and pe
     oscillate: 0 -> 25 Hz in 1 s, -> f_c + A in 3 s, n x [-> f_c - A in P/2, -> f_c + A in P/2],
                -> f_d in P/2, hold f_d for 6 s, -> 100 Hz in 4.3 s
 
+and, with --family release, the aimed release that the Coulomb-oscillator estimate of section 8.1 suggests (a
+ball released at rest at |U| outside a band of half-width r_in stops at the mirror point 2 r_in - |U|): a dwell
+at f_1 collects the runs outside its set on the boundary |U| ~ r_in(f_1), a fast step to f_2 with
+r_in(f_1) ~ 2 r_in(f_2) would fold them to ~0,
+
+    release:   0 -> 25 Hz in 1 s, -> f_1 in the approach time, dwell t_1 at f_1, -> f_2 in the step time (0: at the
+               acceleration limit), dwell at f_2 [, further steps of a staircase], -> 100 Hz in 4.3 s
+
+each release case also run cut at the end of the dwell at f_1 (same starts), so that every run's final |U| is
+paired with its |U| at the release (OUT/stop_depth_release_runs.png against the 1-D fold);
+
 each on the same random starts (abuopt montecarlo), and reports per case the final |I_r| in units of
 r_lock(mu) (mean, p10, median, p90, the share at or below the goal's 0.44 r_lock) and the stop depth
 |I_r| / r_in(f_s) at each run's settling frequency f_s (r_in: the inscribed disc of the set,
@@ -24,8 +35,11 @@ docs/equilibrium_sets.md section 4; 1 = on the boundary, 0 = at a balancing poin
     python3 scripts/stop_depth_study.py --out results/stop_depth [--runs 1024] [--mu 0.02 0.03]
     python3 scripts/stop_depth_study.py --family oscillate --out results/stop_depth_osc --runs 256 \
         [--center 28.9 29.2 29.5] [--amplitude 0.2 0.5 1 1.5] [--period 0.5 1 2 4] [--cycles 1 2 4] [--dwell 28.93 29]
+    python3 scripts/stop_depth_study.py --family release --out results/stop_depth_release --runs 256 \
+        [--f1 28.2 ... 29.6] [--f2 28.85 28.9 29.0] [--stairs 30.5:29.45:28.9] [--dwell1 3 8] [--dwell2 6] \
+        [--step 0 0.5] [--approach-s 3 0.25]
 
-Writes OUT/stop_depth.csv, OUT/stop_depth.md and OUT/stop_depth.png (gnuplot). Needs python3 only.
+Writes OUT/stop_depth{,_osc,_release}.csv, .md and .png (gnuplot). Needs python3 only.
 """
 import argparse
 import csv
@@ -37,7 +51,7 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from startup_study import frequency_at  # noqa: E402  (the inclined-sine profile, one definition)
+from startup_study import MAX_RATE_HZ_S, frequency_at  # noqa: E402  (the inclined-sine profile, one definition)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -79,10 +93,13 @@ def oscillation_segments(f_c, amp, period, cycles, f_d):
     return s + [(f_d, period / 2), (f_d, HOLD_S), (100.0, LAST_S)]
 
 
-def config_text(segs, mu, runs, seed):
+def config_text(segs, mu, runs, seed, end_time_s=None):
+    """end_time_s: stop the simulation there (the state at the end of a truncated profile); None: the default
+    rule (twice the profile duration)."""
     prof = "".join(f"    - {{end_frequency_hz: {f:.6g}, duration_s: {d:.6g}}}\n" for f, d in segs)
+    end = "" if end_time_s is None else f"  end_time_s: {end_time_s:.9g}\n"
     return (f"abu:\n  friction_mu: {mu}\n  ball_contact: hard\nprofile:\n  start_frequency_hz: 0\n  segments:\n{prof}"
-            "motor:\n  kind: ideal\nsimulation:\n  method: event_driven\n  rtol: 1.0e-6\n"
+            "motor:\n  kind: ideal\nsimulation:\n  method: event_driven\n  rtol: 1.0e-6\n" + end +
             f"montecarlo:\n  design: random\n  runs: {runs}\n  seed: {seed}\n  threads: 0\n")
 
 
@@ -105,11 +122,11 @@ def run_oscillation(a, f_c, amp, period, cycles, f_d, mu):
     return measure(a, f"osc_c{f_c:g}_A{amp:g}_P{period:g}_n{cycles}_d{f_d:g}_mu{mu:g}", segs, mu, row)
 
 
-def measure(a, name, segs, mu, row):
-    out = os.path.join(a.out, name)
+def montecarlo(a, out, text):
+    """Run abuopt montecarlo on the config text into out (kept if it ran before on the same text: resumable);
+    returns the rows of runs.csv."""
     os.makedirs(out, exist_ok=True)
     cfg = os.path.join(out, "config.yaml")
-    text = config_text(segs, mu, a.runs, a.seed)
     summary = os.path.join(out, "summary.json")
     if not (os.path.exists(summary) and os.path.exists(cfg) and open(cfg).read() == text):  # resumable
         with open(cfg, "w") as f:
@@ -118,7 +135,13 @@ def measure(a, name, segs, mu, row):
                             "--out", out], capture_output=True, text=True)
         if r.returncode not in (0, 3):
             sys.exit(f"abuopt montecarlo failed on {cfg} (status {r.returncode}):\n{r.stderr}")
-    rows = [r for r in csv.DictReader(open(os.path.join(out, "runs.csv"))) if r["status"] == "ok"]
+    return list(csv.DictReader(open(os.path.join(out, "runs.csv"))))
+
+
+def measure(a, name, segs, mu, row):
+    out = os.path.join(a.out, name)
+    summary = os.path.join(out, "summary.json")
+    rows = [r for r in montecarlo(a, out, config_text(segs, mu, a.runs, a.seed)) if r["status"] == "ok"]
     rl = r_lock(mu)
     ir = [float(r["ir_magnitude_kgm"]) / 1e-7 for r in rows]
     depth = [float(r["ir_magnitude_kgm"]) / 1e-7 / r_in(frequency_at(segs, float(r["settling_time_s"])), mu)
@@ -138,7 +161,188 @@ def measure(a, name, segs, mu, row):
             "wall_s": wall}
 
 
-def main():
+def release_segments(freqs, dwells, approach_s, step_s):
+    """The aimed release: 0 -> 25 Hz in 1 s, -> f_1 in approach_s, dwell t_1 at f_1, then for each later
+    frequency f_k a step -> f_k (in step_s, or with step_s = 0 as fast as the acceleration limit allows:
+    peak rate 2 |f_k - f_(k-1)| / D = MAX_RATE_HZ_S) and a dwell t_k at f_k; -> 100 Hz in 4.3 s."""
+    s = [FIRST, (freqs[0], approach_s), (freqs[0], dwells[0])]
+    for k in range(1, len(freqs)):
+        d = step_s if step_s > 0 else 2 * abs(freqs[k] - freqs[k - 1]) / MAX_RATE_HZ_S
+        s += [(freqs[k], d), (freqs[k], dwells[k])]
+    return s + [(100.0, LAST_S)]
+
+
+def run_release(a, freqs, approach_s, dwell1, step_s, mu):
+    """One release case, and the state at the end of the dwell at f_1 on the same starts (the profile cut
+    there: end_time_s = its duration), paired per run: was the run collected on the boundary of the set of
+    f_1 (|U| >= 0.9 r_in(f_1)), and where did it stop after the release."""
+    dwells = [dwell1] * (len(freqs) - 1) + [a.dwell2]
+    segs = release_segments(freqs, dwells, approach_s, step_s)
+    tag = "_".join(f"{f:g}" for f in freqs)
+    row = {"kind": "release", "freqs": tag, "f1_hz": freqs[0], "f_hold_hz": freqs[-1], "approach_s": approach_s,
+           "dwell1_s": dwell1,
+           "step_s": segs[3][1], "steps": len(freqs) - 1,
+           "peak_rate_hz_s": max(2 * abs(segs[k][0] - segs[k - 1][0]) / segs[k][1] for k in range(3, len(segs) - 1, 2))}
+    name = f"rel_{tag}_a{approach_s:g}_t{dwell1:g}_s{step_s:g}_mu{mu:g}"
+    r = measure(a, name, segs, mu, row)
+    probe_segs = segs[:3]
+    t_probe = sum(d for _, d in probe_segs)
+    probe = montecarlo(a, os.path.join(a.out, f"probe_{freqs[0]:g}_a{approach_s:g}_t{dwell1:g}_mu{mu:g}"),
+                       config_text(probe_segs, mu, a.runs, a.seed, end_time_s=t_probe))
+    final = {x["index"]: x for x in csv.DictReader(open(os.path.join(a.out, name, "runs.csv"))) if x["status"] == "ok"}
+    rin1, rin_h, rl = r_in(freqs[0], mu), r_in(freqs[-1], mu), r_lock(mu)
+    coll, other, moved = [], [], 0
+    for x in probe:
+        y = final.get(x["index"])
+        if x["status"] != "ok" or y is None:
+            continue
+        u1 = float(x["ir_magnitude_kgm"]) / 1e-7
+        uf = float(y["ir_magnitude_kgm"]) / 1e-7
+        (coll if u1 >= 0.9 * rin1 else other).append((u1, uf))
+        if u1 >= 0.9 * rin1 and max(abs(math.remainder(float(x[f"beta_final_{i}"]) - float(y[f"beta_final_{i}"]),
+                                                       2 * math.pi)) for i in (1, 2)) > 0.01:
+            moved += 1
+    # The 1-D Coulomb oscillator's fold of a run released at rest on the boundary of the set of f_1 at each
+    # step: |U| -> |2 r_in(f_k) - |U|| while |U| > r_in(f_k) (a run inside the set of f_k stays).
+    pred = rin1
+    for f in freqs[1:]:
+        if pred > r_in(f, mu):
+            pred = abs(2 * r_in(f, mu) - pred)
+    n = len(coll) + len(other)
+    mean = (lambda v: sum(v) / len(v) if v else float("nan"))
+    r["_pairs"] = coll + other  # per run: |U| at the end of the dwell at f_1 and the final |U| [1e-7 kg m]
+    r.update({"rin1": rin1, "rin_hold": rin_h, "q": rin1 / rin_h, "share_collected": len(coll) / n if n else float("nan"),
+              "u1_collected_over_rin1": mean([u for u, _ in coll]) / rin1,
+              "final_collected_over_rlock": mean([v for _, v in coll]) / rl,
+              "final_others_over_rlock": mean([v for _, v in other]) / rl,
+              "share_collected_moved": moved / len(coll) if coll else float("nan"),
+              "predicted_fold_over_rlock": pred / rl,
+              "final_collected_p10_over_rlock": quantile([v for _, v in coll], 0.1) / rl if coll else float("nan"),
+              "final_collected_p90_over_rlock": quantile([v for _, v in coll], 0.9) / rl if coll else float("nan")})
+    return r
+
+
+def release(a):
+    for k, v in (("--dwell1", a.dwell1), ("--dwell2", [a.dwell2]), ("--approach-s", a.approach_s)):
+        if min(v) <= 0:
+            sys.exit(f"{k} {min(v):g}: must be > 0")
+    if min(a.step) < 0:
+        sys.exit(f"--step {min(a.step):g}: must be >= 0 (0: the acceleration limit)")
+    chains = [[f1, f2] for f1 in a.f1 for f2 in a.f2]
+    for st in a.stairs:
+        try:
+            c = [float(v) for v in st.split(":")]
+        except ValueError:
+            sys.exit(f"--stairs {st}: must be frequencies separated by ':' (e.g. 29.6:29.2:28.9)")
+        if len(c) < 2:
+            sys.exit(f"--stairs {st}: needs at least two frequencies")
+        chains.append(c)
+    rows = []
+    for mu in a.mu:
+        for c in chains:
+            for ap_s, t1, st in [(x, y, z) for x in a.approach_s for y in a.dwell1 for z in a.step]:
+                    r = run_release(a, c, ap_s, t1, st, mu)
+                    rows.append(r)
+                    print(f"release {r['freqs']:>16s} approach {ap_s:4.2f} t1 {t1:4.1f} step {r['step_s']:5.3f} s mu {mu:.2f}: mean "
+                          f"{r['mean']:6.2f} = {r['mean_over_rlock']:.3f} r_lock; collected {100 * r['share_collected']:5.1f} % "
+                          f"-> {r['final_collected_over_rlock']:.3f} r_lock (fold predicts {r['predicted_fold_over_rlock']:.3f}), "
+                          f"others {r['final_others_over_rlock']:.3f}", flush=True)
+    release_runs_plot(a, rows)
+    for r in rows:
+        del r["_pairs"]
+    with open(os.path.join(a.out, "stop_depth_release.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    lines = [f"# Aimed release: dwell at f_1, fast step(s) to the hold speed ({a.runs} random starts, seed {a.seed}, "
+             f"contact hard, last dwell {a.dwell2:g} s)", "",
+             "collected: runs with |U| >= 0.9 r_in(f_1) at the end of the dwell at f_1 (same starts, profile cut there); "
+             "fold: the 1-D Coulomb oscillator's stop of a run released at rest on that boundary.", ""]
+    for mu in a.mu:
+        sub = sorted((r for r in rows if r["mu"] == mu), key=lambda r: r["mean_over_rlock"])
+        lines += [f"mu {mu:g} (r_lock {r_lock(mu):.2f}): {len(sub)} cases, mean / r_lock from {sub[0]['mean_over_rlock']:.3f} "
+                  f"to {sub[-1]['mean_over_rlock']:.3f}", "",
+                  "| speeds [Hz] | approach [s] | t_1 [s] | step [s] | r_in(f_1) / r_in(f_h) | mean \|I_r\| [95 %] | mean / r_lock | "
+                  "share <= 0.44 r_lock | collected | collected: \|U\| / r_in(f_1) at release | collected: final / r_lock "
+                  "(p10, p90) | fold predicts | collected runs that moved | others: final / r_lock |", "|" + "---|" * 14]
+        for r in sub:
+            lines.append(f"| {r['freqs'].replace('_', ' -> ')} | {r['approach_s']:g} | {r['dwell1_s']:g} | {r['step_s']:.3g} | {r['q']:.2f} | "
+                         f"{r['mean']:.2f} +- {r['hw95']:.2f} | {r['mean_over_rlock']:.3f} | "
+                         f"{100 * r['share_at_goal_depth']:.1f} % | {100 * r['share_collected']:.1f} % | "
+                         f"{r['u1_collected_over_rin1']:.3f} | {r['final_collected_over_rlock']:.3f} "
+                         f"({r['final_collected_p10_over_rlock']:.3f}, {r['final_collected_p90_over_rlock']:.3f}) | "
+                         f"{r['predicted_fold_over_rlock']:.3f} | {100 * r['share_collected_moved']:.0f} % | "
+                         f"{r['final_others_over_rlock']:.3f} |")
+        lines.append("")
+    with open(os.path.join(a.out, "stop_depth_release.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    print("\n".join(lines))
+    with open(os.path.join(a.out, "stop_depth_release.dat"), "w") as f:
+        for mu in a.mu:
+            f.write(f"# mu {mu}: r_in(f_1) / r_in(f_h), collected runs' final / r_in(f_h), fold |2 - q|, all runs\n")
+            for r in rows:
+                if r["mu"] == mu and r["steps"] == 1:
+                    rl_over_rin = r_lock(mu) / r["rin_hold"]
+                    f.write(f"{r['q']:.4f} {r['final_collected_over_rlock'] * rl_over_rin:.4f} {abs(2 - r['q']):.4f} "
+                            f"{r['mean_over_rlock'] * rl_over_rin:.4f}\n")
+            f.write("\n\n")
+    plots = ", ".join(f"'stop_depth_release.dat' index {k} using 1:2 with points pt {7 + k} ps 1.0 title 'collected runs, mu {mu:g}', "
+                      f"'' index {k} using 1:4 with points pt {4 + k} ps 0.8 title 'all runs, mu {mu:g}'"
+                      for k, mu in enumerate(a.mu))
+    qs = [r["q"] for r in rows if r["steps"] == 1]
+    write_plot(a.out, "stop_depth_release",
+               f"set title 'aimed release: mean final |I_r| / r_in(f_h) against r_in(f_1) / r_in(f_h) ({a.runs} starts, "
+               "contact hard)'\nset xlabel 'r_in(f_1) / r_in(f_h) (the fold aims at 2)'\n"
+               f"set xrange [{min(qs) - 0.1:.3f}:{max(qs) + 0.1:.3f}]\nset samples 200\n"
+               "set ylabel 'mean final |I_r| / r_in(f_h)'\nset yrange [0:*]\nset key top left\n"
+               f"plot {plots}, abs(2 - x) with lines lw 2 lc rgb 'black' title '1-D fold |2 - q| (Coulomb oscillator)'\n")
+
+
+def release_runs_plot(a, rows):
+    """Per run, final |U| against |U| at the end of the dwell at f_1, for the case per friction whose fold aims
+    nearest to a balancing point (one step, f_1 above resonance, the most runs collected among |q - 2| <= 0.3), beside
+    the 1-D fold: a run at |U| > r_in(f_2) stops at |2 r_in(f_2) - |U||, one inside stays."""
+    fn = OMEGA_N / (2 * math.pi)
+    picks = []
+    for mu in a.mu:
+        cand = [r for r in rows if r["mu"] == mu and r["steps"] == 1 and r["f1_hz"] > fn and abs(r["q"] - 2) <= 0.3]
+        if cand:
+            picks.append(max(cand, key=lambda r: (r["share_collected"], -abs(r["q"] - 2))))
+    if not picks:
+        return
+    lines = []
+    with open(os.path.join(a.out, "stop_depth_release_runs.dat"), "w") as f:
+        for k, r in enumerate(picks):
+            rl, rin2 = r_lock(r["mu"]), r["rin_hold"]
+            f.write(f"# {r['freqs']} approach {r['approach_s']:g} s step {r['step_s']:.3g} s mu {r['mu']}: "
+                    "|U| at release / r_in(f_1), final / r_lock, 1-D fold / r_lock\n")
+            for u1, uf in r["_pairs"]:
+                fold = abs(2 * rin2 - u1) if u1 > rin2 else u1
+                f.write(f"{u1 / r['rin1']:.4f} {uf / rl:.4f} {fold / rl:.4f}\n")
+            f.write("\n\n")
+            lines.append(f"'stop_depth_release_runs.dat' index {k} using 1:2 with points pt {7 + k} ps 0.6 title "
+                         f"'{r['freqs'].replace('_', ' -> ')} Hz, mu {r['mu']:g}: final', "
+                         f"'' index {k} using 1:3 with points pt 1 ps 0.4 lc rgb '{'black' if k == 0 else 'gray40'}' "
+                         f"title '1-D fold, mu {r['mu']:g}'")
+    write_plot(a.out, "stop_depth_release_runs",
+               f"set title 'aimed release, per run ({a.runs} starts): final |I_r| against |I_r| at the end of the dwell "
+               "at f_1'\nset xlabel '|I_r| at the end of the dwell at f_1 / r_in(f_1)  (>= 0.9: collected on the "
+               "boundary)'\nset ylabel 'final |I_r| / r_lock(mu)'\nset yrange [0:*]\nset xrange [0:*]\n"
+               "set key top left\nset arrow from 0.9, graph 0 to 0.9, graph 1 nohead dt 2\n"
+               f"plot {', '.join(lines)}, {GOAL_FRACTION} with lines lw 2 lc rgb 'black' title 'goal 0.44 r_lock'\n")
+
+
+def write_plot(out, name, body):
+    """Write OUT/NAME.gp (the common preamble: a 1000 x 650 PNG OUT/NAME.png, grid) followed by body, and run
+    gnuplot on it in OUT if gnuplot is installed (the data files body names are relative to OUT)."""
+    with open(os.path.join(out, name + ".gp"), "w") as f:
+        f.write(f"set terminal pngcairo size 1000,650 noenhanced\nset output '{name}.png'\nset grid\n" + body)
+    gp = shutil.which("gnuplot")
+    if gp:
+        subprocess.run([gp, name + ".gp"], cwd=out, capture_output=True)
+
+
+def parser():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", default=os.path.join("results", "stop_depth"))
     ap.add_argument("--abuopt", default=os.path.join(ROOT, "build", "app", "abuopt"))
@@ -149,13 +353,27 @@ def main():
     ap.add_argument("--mu", type=float, nargs="+", default=[0.02, 0.03])
     ap.add_argument("--hold", type=float, nargs="+", default=[28.85, 29.0, 29.2])
     ap.add_argument("--approach", type=float, nargs="+", default=[0.25, 0.5, 1, 2, 4, 8, 16, 32])
-    ap.add_argument("--family", choices=["approach", "oscillate"], default="approach")
+    ap.add_argument("--family", choices=["approach", "oscillate", "release"], default="approach")
+    ap.add_argument("--f1", type=float, nargs="+", default=[28.2, 28.3, 28.4, 29.4, 29.45, 29.5, 29.6],
+                    help="release: the collecting speed f_1 [Hz]")
+    ap.add_argument("--f2", type=float, nargs="+", default=[28.85, 28.9, 29.0], help="release: the hold speed f_2 [Hz]")
+    ap.add_argument("--stairs", nargs="*", default=[], help="release: staircases f_1:f_2:...:f_h [Hz] (dwell t_1 at each but the last)")
+    ap.add_argument("--dwell1", type=float, nargs="+", default=[3.0, 8.0], help="release: dwell t_1 at f_1 [s]")
+    ap.add_argument("--dwell2", type=float, default=HOLD_S, help="release: dwell at the hold speed [s]")
+    ap.add_argument("--step", type=float, nargs="+", default=[0.0, 0.5],
+                    help="release: step duration [s] (0: the acceleration limit, peak rate %g Hz/s)" % MAX_RATE_HZ_S)
+    ap.add_argument("--approach-s", type=float, nargs="+", default=[3.0, 0.25],
+                    help="release: 25 Hz -> f_1 in this time [s] (fast: the balls cross resonance without stopping)")
     ap.add_argument("--center", type=float, nargs="+", default=[28.9, 29.2, 29.5], help="oscillate: f_c [Hz]")
     ap.add_argument("--amplitude", type=float, nargs="+", default=[0.2, 0.5, 1.0, 1.5], help="oscillate: A [Hz]")
     ap.add_argument("--period", type=float, nargs="+", default=[0.5, 1, 2, 4], help="oscillate: P [s]")
     ap.add_argument("--cycles", type=int, nargs="+", default=[1, 2, 4], help="oscillate: n")
     ap.add_argument("--dwell", type=float, nargs="+", default=[28.93, 29.0], help="oscillate: f_d [Hz]")
-    a = ap.parse_args()
+    return ap
+
+
+def main():
+    a = parser().parse_args()
     if a.runs < 2:
         sys.exit(f"--runs {a.runs}: must be >= 2")
     if not os.access(a.abuopt, os.X_OK):
@@ -163,6 +381,8 @@ def main():
     os.makedirs(a.out, exist_ok=True)
     if a.family == "oscillate":
         return oscillate(a)
+    if a.family == "release":
+        return release(a)
     rows = []
     for mu in a.mu:
         for kind in ("up", "down"):
@@ -195,7 +415,6 @@ def main():
         f.write("\n".join(lines) + "\n")
     print("\n".join(lines[-1:]))
     # Plot: mean |I_r| / r_lock (p10..p90 bars) against the approach duration, per case.
-    gp = shutil.which("gnuplot")
     dat = os.path.join(a.out, "stop_depth.dat")
     series = []
     with open(dat, "w") as f:
@@ -211,15 +430,11 @@ def main():
                     series.append(f"{kind} to {f_h:g} Hz, mu {mu:g}")
     plots = ", ".join(f"'stop_depth.dat' index {k} using 1:2 with linespoints lw 1.5 dt {1 if 'up' in s else 2} "
                       f"pt {k % 13 + 1} title '{s}'" for k, s in enumerate(series))
-    gpf = os.path.join(a.out, "stop_depth.gp")
-    with open(gpf, "w") as f:
-        f.write("set terminal pngcairo size 1000,650 noenhanced\nset output 'stop_depth.png'\nset grid\n"
-                f"set title 'mean |I_r| / r_lock(mu) against the approach duration ({a.runs} starts, contact hard)'\n"
-                "set xrange [0.2:40]\nset xlabel 'approach duration D to the hold frequency [s] (log)'\nset logscale x\n"
-                "set ylabel 'mean |I_r| / r_lock(mu)'\nset yrange [0:1.4]\nset key outside right\n"
-                f"plot {plots}, {GOAL_FRACTION} with lines lw 2 lc rgb 'black' title 'goal 7.0e-7 = 0.44 r_lock'\n")
-    if gp:
-        subprocess.run([gp, "stop_depth.gp"], cwd=a.out, capture_output=True)
+    write_plot(a.out, "stop_depth",
+               f"set title 'mean |I_r| / r_lock(mu) against the approach duration ({a.runs} starts, contact hard)'\n"
+               "set xrange [0.2:40]\nset xlabel 'approach duration D to the hold frequency [s] (log)'\nset logscale x\n"
+               "set ylabel 'mean |I_r| / r_lock(mu)'\nset yrange [0:1.4]\nset key outside right\n"
+               f"plot {plots}, {GOAL_FRACTION} with lines lw 2 lc rgb 'black' title 'goal 7.0e-7 = 0.44 r_lock'\n")
 
 
 def oscillate(a):
@@ -265,7 +480,6 @@ def oscillate(a):
     with open(os.path.join(a.out, "stop_depth_osc.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print("\n".join(lines))
-    gp = shutil.which("gnuplot")
     with open(os.path.join(a.out, "stop_depth_osc.dat"), "w") as f:
         for mu in a.mu:
             f.write(f"# mu {mu}: peak rate, mean / r_lock, cycles\n")
@@ -275,14 +489,11 @@ def oscillate(a):
             f.write("\n\n")
     plots = ", ".join(f"'stop_depth_osc.dat' index {k} using 1:2 with points pt {7 + k} ps 0.8 title 'mu {mu:g}'"
                       for k, mu in enumerate(a.mu))
-    with open(os.path.join(a.out, "stop_depth_osc.gp"), "w") as f:
-        f.write("set terminal pngcairo size 1000,650 noenhanced\nset output 'stop_depth_osc.png'\nset grid\n"
-                f"set title 'oscillations through the band: mean |I_r| / r_lock(mu) per case ({a.runs} starts, "
-                "contact hard)'\nset logscale x\nset xlabel 'peak rate of the profile after 25 Hz [Hz/s] (log)'\n"
-                "set ylabel 'mean |I_r| / r_lock(mu)'\nset yrange [0:*]\nset key top left\n"
-                f"plot {plots}, {GOAL_FRACTION} with lines lw 2 lc rgb 'black' title 'goal 7.0e-7 = 0.44 r_lock'\n")
-    if gp:
-        subprocess.run([gp, "stop_depth_osc.gp"], cwd=a.out, capture_output=True)
+    write_plot(a.out, "stop_depth_osc",
+               f"set title 'oscillations through the band: mean |I_r| / r_lock(mu) per case ({a.runs} starts, "
+               "contact hard)'\nset logscale x\nset xlabel 'peak rate of the profile after 25 Hz [Hz/s] (log)'\n"
+               "set ylabel 'mean |I_r| / r_lock(mu)'\nset yrange [0:*]\nset key top left\n"
+               f"plot {plots}, {GOAL_FRACTION} with lines lw 2 lc rgb 'black' title 'goal 7.0e-7 = 0.44 r_lock'\n")
 
 
 if __name__ == "__main__":

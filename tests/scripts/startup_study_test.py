@@ -104,6 +104,11 @@ def unit(abuopt, tmp):
     check(p["n"] == 3 and abs(p["mean"] - 3.0) < 1e-12 and abs(p["hi"] - 3.0 - 1.96 / 3 ** 0.5) < 1e-12
           and abs(p["relative_pct"] - 150.0) < 1e-9, f"paired difference {p}")
 
+    # Stage 8's case counts (its ETA) against the grids of scripts/stop_depth_study.py: quick 2 x 2 x 3 x 4 approaches,
+    # 2 x 8 oscillations, 2 x 2 x 2 x 2 releases; full: the published 96 and 576, and the two release scans.
+    counts = {w: [study.stop_depth_cases(f, args) for f, args in study.STOP_DEPTH[w]] for w in ("quick", "full")}
+    check(counts == {"quick": [48, 16, 16], "full": [96, 576, 144, 36]}, f"stop-depth case counts {counts}")
+
     # A folder made with one contact setting is refused with the other, before any work.
     out = os.path.join(tmp, "mixed")
     os.makedirs(out)
@@ -125,8 +130,10 @@ def end_to_end(abuopt, tmp):
         return
     s = json.load(open(os.path.join(out, "summary.json")))
     check(s["contact"] == "hard", "summary.json records contact hard")
-    f3_aimed = {f"{n}_from_{start}" for n in ("f3_mu03", "f3_robust_k6") for start in ("global", "k6")}
-    n_expected = 20  # 16 + the four aimed formulation-3 designs
+    f3_aimed = ({f"{n}_from_{start}" for n in ("f3_mu03", "f3_robust_k6") for start in ("global", "k6")}
+                | {"f3_mu03_k4_from_global", "f3_mu03_k4_from_k4", "f3_mu03_release_from_global",
+                   "f3_mu03_release_from_scan"})
+    n_expected = 25  # 16 + the eight aimed formulation-3 designs + formulation 2 with the PI motor
     check(len(s["table"]) == n_expected and f3_aimed <= set(s["table"])
           and all(row["ideal"]["ok"] == 8 and row["s9002"]["ok"] == 8 for row in s["table"].values()),
           f"{len(s['table'])} designs validated on seeds 9001 and 9002, every run ok")
@@ -139,12 +146,22 @@ def end_to_end(abuopt, tmp):
     check(len(s["f2"]["steps"]) == 4 and s["f2"]["ref"]["runs"] == 5 and
           {r["start"] for r in s["f2"]["steps"]} == {"front6", "front8", "front11", "sweep19_scaled8"},
           "formulation 2: one startup-time minimisation per start recorded")
+    check(len(s["f2_pi"]["steps"]) == 3 and s["f2_pi"]["ref"]["runs"] == 5 and
+          {r["start"] for r in s["f2_pi"]["steps"]} == {"pi_ideal_f2", "pi_front8", "pi_front11"} and
+          "kind: pi" in study.read(os.path.join(out, "f2_pi_front8", "config.yaml")) and
+          "kind: pi" in study.read(os.path.join(out, "f2_ref2003_pi", "config.yaml")) and
+          "kind: pi" in study.read(os.path.join(out, "best", "f2pi_min_T.yaml")),
+          "formulation 2 with the PI motor: three starts, the PI motor in every optimised config and in its design")
+    for fam in ("approach", "oscillate", "release"):
+        md = os.path.join(out, f"stop_depth_{fam}", "stop_depth" + ("" if fam == "approach" else "_osc" if fam ==
+                                                                       "oscillate" else "_release") + ".md")
+        check(os.path.exists(md), f"stage 8 (stop depth, quick): {fam} family written")
     f2cfg = study.read(os.path.join(out, "f2_front8", "config.yaml"))
     check("kind: startup_time" in f2cfg and "max_mean_abs_ir:" in f2cfg and "max_startup_time_s: 19" in f2cfg,
           "formulation 2 minimises startup_time with the max_mean_abs_ir bound")
     cost = json.load(open(os.path.join(out, "stage_cost.json")))
     stages = [c["stage"] for c in cost]
-    check(len(stages) == 8 and all(c["cpu_s"] >= 0 and c["wall_s"] >= 0 for c in cost) and cost[0]["cpu_s"] > 0
+    check(len(stages) == 10 and all(c["cpu_s"] >= 0 and c["wall_s"] >= 0 for c in cost) and cost[0]["cpu_s"] > 0
           and "[cost] whole study: CPU" in r.stdout, f"the cost of every stage is recorded: {stages}")
     configs = [os.path.join(d, "config.yaml") for d in
                [os.path.join(out, x) for x in os.listdir(out)] + [os.path.join(out, "validation", x) for x in

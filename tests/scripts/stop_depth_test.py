@@ -62,6 +62,35 @@ def main(abuopt):
               "the case's mean and mean / r_lock are those of runs.csv")
         again = sd.run_case(a, "up", 29.0, 1.0, 0.02)  # resumed: kept, same numbers
         check(again["mean"] == row["mean"], "a finished case is kept and gives the same numbers")
+    # The release family: the step at the acceleration limit (an inclined sine peaks at 2 H / D), the fold of the
+    # 1-D Coulomb oscillator, and a tiny case paired run by run with the state at the end of the dwell at f_1.
+    segs = sd.release_segments([29.45, 28.9], [3.0, 6.0], 3.0, 0.0)
+    check(segs[:3] == [(25.0, 1.0), (29.45, 3.0), (29.45, 3.0)] and segs[4:] == [(28.9, 6.0), (100.0, 4.3)]
+          and segs[3][0] == 28.9 and abs(2 * 0.55 / segs[3][1] - sd.MAX_RATE_HZ_S) < 1e-9,
+          f"release: the step 29.45 -> 28.9 Hz takes 2 x 0.55 / {sd.MAX_RATE_HZ_S:.3f} s ({segs[3][1]:.4f} s)")
+    stairs = sd.release_segments([30.5, 29.45, 28.9], [2.0, 2.0, 6.0], 0.25, 0.4)
+    check([f for f, _ in stairs] == [25.0, 30.5, 30.5, 29.45, 29.45, 28.9, 28.9, 100.0]
+          and [d for _, d in stairs][3:7] == [0.4, 2.0, 0.4, 6.0], "release: a staircase of two steps")
+    with tempfile.TemporaryDirectory() as tmp:
+        a = types.SimpleNamespace(out=tmp, abuopt=abuopt, runs=8, seed=5, threads=1, nice=0, dwell2=2.0)
+        row = sd.run_release(a, [29.45, 28.9], 0.25, 1.0, 0.0, 0.02)
+        rin1, rin2 = sd.r_in(29.45, 0.02), sd.r_in(28.9, 0.02)
+        check(abs(row["predicted_fold_over_rlock"] - abs(2 * rin2 - rin1) / sd.r_lock(0.02)) < 1e-12
+              and abs(row["q"] - rin1 / rin2) < 1e-12, "release: the fold |2 r_in(f_2) - r_in(f_1)| and q")
+        probe = os.path.join(tmp, "probe_29.45_a0.25_t1_mu0.02")
+        cfg = open(os.path.join(probe, "config.yaml")).read()
+        check("end_time_s: 2.25\n" in cfg and "duration_s: 1}" in cfg and "end_frequency_hz: 28.9" not in cfg,
+              "release: the probe is the profile cut at the end of the dwell at f_1 (t = 1 + 0.25 + 1 s)")
+        full = list(csv.DictReader(open(os.path.join(tmp, "rel_29.45_28.9_a0.25_t1_s0_mu0.02", "runs.csv"))))
+        cut = list(csv.DictReader(open(os.path.join(probe, "runs.csv"))))
+        check(len(full) == len(cut) == 8 and all(x["beta0_1"] == y["beta0_1"] and x["beta0_2"] == y["beta0_2"]
+                                                 for x, y in zip(full, cut)),
+              "release: the probe runs the same starts, run by run")
+        u1 = [float(x["ir_magnitude_kgm"]) / 1e-7 for x in cut]
+        check(abs(row["share_collected"] - sum(1 for u in u1 if u >= 0.9 * rin1) / 8) < 1e-12,
+              f"release: the collected share is that of the probe's runs ({row['share_collected']:.3f})")
+        again = sd.run_release(a, [29.45, 28.9], 0.25, 1.0, 0.0, 0.02)
+        check(again["mean"] == row["mean"], "release: a finished case is kept and gives the same numbers")
     if failures:
         print(f"{len(failures)} check(s) failed")
         sys.exit(1)
