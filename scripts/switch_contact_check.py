@@ -29,6 +29,8 @@ DESIGNS = [
     ("contact_f2_min_T", BEST + "/contact_f2_min_T.yaml", []),
     ("contact_best_mu03 (mu 0.03)", BEST + "/contact_best_mu03.yaml", ["--mu", "0.03"]),
     ("contact_best_robust", BEST + "/contact_best_robust.yaml", []),
+    ("contact_f2_min_T_pi (PI motor)", BEST + "/contact_f2_min_T_pi.yaml", []),
+    ("contact_best_mu03_k4 (mu 0.03)", BEST + "/contact_best_mu03_k4.yaml", ["--mu", "0.03"]),
 ]
 
 
