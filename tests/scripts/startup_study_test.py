@@ -13,7 +13,6 @@ end_to_end: every stage runs and writes its outputs, every optimised and validat
 contact setting, and a second run replays every evaluation from the archives (nothing computed).
 """
 import csv
-import importlib.util
 import json
 import os
 import re
@@ -21,19 +20,10 @@ import subprocess
 import sys
 import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from script_check import ROOT, check, failures, load_script
+
 SCRIPT = os.path.join(ROOT, "scripts", "startup_study.py")
-spec = importlib.util.spec_from_file_location("startup_study", SCRIPT)
-study = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(study)
-
-failures = []
-
-
-def check(cond, what):
-    print(("ok   " if cond else "FAIL ") + what)
-    if not cond:
-        failures.append(what)
+study = load_script("startup_study")
 
 
 def active_contact_lines(text):

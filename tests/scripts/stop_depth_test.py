@@ -10,24 +10,15 @@ f; the profile's frequency at time t against the inclined-sine closed form at th
 middles; and a tiny case (8 runs) runs through abuopt and gives statistics consistent with runs.csv.
 """
 import csv
-import importlib.util
 import os
 import subprocess
 import sys
 import tempfile
 import types
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-spec = importlib.util.spec_from_file_location("stop_depth_study", os.path.join(ROOT, "scripts", "stop_depth_study.py"))
-sd = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(sd)
-failures = []
+from script_check import ROOT, check, failures, load_script
 
-
-def check(cond, what):
-    print(("ok   " if cond else "FAIL ") + what)
-    if not cond:
-        failures.append(what)
+sd = load_script("stop_depth_study")
 
 
 def main(abuopt):

@@ -8,23 +8,14 @@ each friction method, the band only where asked, and an error where a config has
 set), and the script runs end to end on 4 starts per design: two summary rows per design, the
 paired table has a row per design, and its run counts add up.
 """
-import importlib.util
 import os
 import subprocess
 import sys
 import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-spec = importlib.util.spec_from_file_location("switch_contact_check", os.path.join(ROOT, "scripts", "switch_contact_check.py"))
-sc = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(sc)
-failures = []
+from script_check import ROOT, check, failures, load_script
 
-
-def check(cond, what):
-    print(("ok   " if cond else "FAIL ") + what)
-    if not cond:
-        failures.append(what)
+sc = load_script("switch_contact_check")
 
 
 def main(abuopt):
