@@ -274,18 +274,16 @@ def release(a):
                          f"{r['predicted_fold_over_rlock']:.3f} | {100 * r['share_collected_moved']:.0f} % | "
                          f"{r['final_others_over_rlock']:.3f} |")
         lines.append("")
-    with open(os.path.join(a.out, "stop_depth_release.md"), "w") as f:
-        f.write("\n".join(lines) + "\n")
-    print("\n".join(lines))
-    with open(os.path.join(a.out, "stop_depth_release.dat"), "w") as f:
-        for mu in a.mu:
-            f.write(f"# mu {mu}: r_in(f_1) / r_in(f_h), collected runs' final / r_in(f_h), fold |2 - q|, all runs\n")
-            for r in rows:
-                if r["mu"] == mu and r["steps"] == 1:
-                    rl_over_rin = r_lock(mu) / r["rin_hold"]
-                    f.write(f"{r['q']:.4f} {r['final_collected_over_rlock'] * rl_over_rin:.4f} {abs(2 - r['q']):.4f} "
-                            f"{r['mean_over_rlock'] * rl_over_rin:.4f}\n")
-            f.write("\n\n")
+    def release_row(r):
+        if r["steps"] != 1:
+            return None
+        rl_over_rin = r_lock(r["mu"]) / r["rin_hold"]
+        return (f"{r['q']:.4f} {r['final_collected_over_rlock'] * rl_over_rin:.4f} {abs(2 - r['q']):.4f} "
+                f"{r['mean_over_rlock'] * rl_over_rin:.4f}\n")
+
+    write_md_and_dat(a, "stop_depth_release", lines, rows,
+                     lambda mu: f"# mu {mu}: r_in(f_1) / r_in(f_h), collected runs' final / r_in(f_h), fold |2 - q|, all runs\n",
+                     release_row)
     plots = ", ".join(f"'stop_depth_release.dat' index {k} using 1:2 with points pt {7 + k} ps 1.0 title 'collected runs, mu {mu:g}', "
                       f"'' index {k} using 1:4 with points pt {4 + k} ps 0.8 title 'all runs, mu {mu:g}'"
                       for k, mu in enumerate(a.mu))
@@ -330,6 +328,22 @@ def release_runs_plot(a, rows):
                "boundary)'\nset ylabel 'final |I_r| / r_lock(mu)'\nset yrange [0:*]\nset xrange [0:*]\n"
                "set key top left\nset arrow from 0.9, graph 0 to 0.9, graph 1 nohead dt 2\n"
                f"plot {', '.join(lines)}, {GOAL_FRACTION} with lines lw 2 lc rgb 'black' title 'goal 0.44 r_lock'\n")
+
+
+def write_md_and_dat(a, stem, lines, rows, header, row_text):
+    """OUT/stem.md (the lines, also printed) and OUT/stem.dat: one gnuplot index per friction of a.mu,
+    header(mu) then row_text(r) of each of its rows (None: the row is left out)."""
+    with open(os.path.join(a.out, stem + ".md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    print("\n".join(lines))
+    with open(os.path.join(a.out, stem + ".dat"), "w") as f:
+        for mu in a.mu:
+            f.write(header(mu))
+            for r in rows:
+                text = row_text(r) if r["mu"] == mu else None
+                if text is not None:
+                    f.write(text)
+            f.write("\n\n")
 
 
 def write_plot(out, name, body):
@@ -477,16 +491,8 @@ def oscillate(a):
             lines.append(f"least mean / r_lock per {label}: " + ", ".join(
                 f"{v:g}: {min(r['mean_over_rlock'] for r in sub if r[key] == v):.3f}" for v in vals))
         lines.append("")
-    with open(os.path.join(a.out, "stop_depth_osc.md"), "w") as f:
-        f.write("\n".join(lines) + "\n")
-    print("\n".join(lines))
-    with open(os.path.join(a.out, "stop_depth_osc.dat"), "w") as f:
-        for mu in a.mu:
-            f.write(f"# mu {mu}: peak rate, mean / r_lock, cycles\n")
-            for r in rows:
-                if r["mu"] == mu:
-                    f.write(f"{r['peak_rate_hz_s']:.4f} {r['mean_over_rlock']:.4f} {r['cycles']}\n")
-            f.write("\n\n")
+    write_md_and_dat(a, "stop_depth_osc", lines, rows, lambda mu: f"# mu {mu}: peak rate, mean / r_lock, cycles\n",
+                     lambda r: f"{r['peak_rate_hz_s']:.4f} {r['mean_over_rlock']:.4f} {r['cycles']}\n")
     plots = ", ".join(f"'stop_depth_osc.dat' index {k} using 1:2 with points pt {7 + k} ps 0.8 title 'mu {mu:g}'"
                       for k, mu in enumerate(a.mu))
     write_plot(a.out, "stop_depth_osc",
