@@ -11,11 +11,14 @@ so a run's depth |U| / r_lock is at least its gauge.
 
     scripts/stop_distribution.py geometry --mu 0.03 [--grid 256]      # uniform starts inside the lock set
     scripts/stop_distribution.py jacobian                             # the map (beta_1, beta_2) -> U at balance
-    scripts/stop_distribution.py runs RUNS_CSV --profile 25:1,29.5:10,100:8 --mu 0.03 [--entry CUT_CSV]
+    scripts/stop_distribution.py runs RUNS_CSV --profile 25:1,29.5:10,100:8 --mu 0.03 [--entry CUT_CSV] [--plot DIR]
 
 `runs` reads the runs.csv of `abuopt montecarlo ... --out DIR` (two balls); a run is EARLY when it settled below
 the band (r_in(f_s) > 2 r_lock, f_s below resonance: it never moved again), LATE otherwise. --entry: the runs.csv
-of the same starts cut at a time inside the band (`simulation.end_time_s`), for the directions of U there.
+of the same starts cut at a time inside the band (`simulation.end_time_s`), for the directions of U there; --plot:
+the CDFs of the lock gauge (against t and t^2) and of the depth, early and late runs, as DIR/stop_distribution.png.
+A CLOSE PAIR has its balls within 0.04 rad of the contact distance (touching or nearly): it cannot end below the
+pair floor |m_I e - 2 m L cos(s/2)| >= 11.11e-7 kg m.
 Parameters are the report's (table 3.2), as in scripts/final_states_in_set.py.
 """
 import argparse
@@ -27,6 +30,7 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from final_states_in_set import MT, B, K, L, MI, E, M_BALL, profile_frequency  # noqa: E402
+from stop_depth_study import write_plot  # noqa: E402
 
 M = MT + MI + 2 * M_BALL
 OMEGA_N = math.sqrt(K / M)
@@ -71,6 +75,29 @@ def gauge(f, betas, mu):
 def lock_gauge(betas, mu, freqs=LOCK_FREQS):
     """max_f gauge(f): <= 1 when the configuration is in the set of every speed of freqs."""
     return max(gauge(f, betas, mu) for f in freqs)
+
+
+BALL_DIAMETER = 3.0e-3
+CONTACT_SEPARATION = 2 * math.asin(BALL_DIAMETER / (2 * L))  # touching balls: 0.2616 rad apart (docs/model.md 11.1)
+
+
+def touching_floor():
+    """The least |U| of two touching balls (separation s_c): |m_I e - 2 m L cos(s_c / 2)| = 11.20e-7 kg m."""
+    return abs(MI * E - 2 * M_BALL * L * math.cos(CONTACT_SEPARATION / 2))
+
+
+CLOSE_TOL = 0.04  # rad: a "close pair" (touching or nearly: gap below 0.46 mm); its pair floor is >= 11.11e-7 kg m
+
+
+def separation(betas):
+    """The wrapped angle between the two balls, in [0, pi]."""
+    d = (betas[0] - betas[1]) % (2 * math.pi)
+    return min(d, 2 * math.pi - d)
+
+
+def is_touching(betas, tol=CLOSE_TOL):
+    """Ball separation within tol [rad] of the contact distance: a close pair."""
+    return abs(separation(betas) - CONTACT_SEPARATION) <= tol
 
 
 def balancing_separation():
@@ -157,7 +184,8 @@ def analyse_runs(rows, segments, mu, entry=None):
         f = profile_frequency(segments, float(r["settling_time_s"]))
         b = (float(r["beta_final_1"]), float(r["beta_final_2"]))
         rec = {"f_s": f, "depth": abs(imbalance(b)) / rl, "g_s": gauge(f, b, mu), "g_lock": lock_gauge(b, mu),
-               "dir": mirrored_direction(b), "index": r["index"]}
+               "dir": mirrored_direction(b), "index": r["index"], "touching": is_touching(b),
+               "separation": separation(b)}
         (early if r_in(f, mu) > 2 * rl and f < F_N else late).append(rec)
     n = len(early) + len(late)
     out = {"runs": n, "r_lock": rl}
@@ -167,8 +195,12 @@ def analyse_runs(rows, segments, mu, entry=None):
                      "ks_path": ks_power([x["g_lock"] for x in grp], 1), "ks_disc": ks_power([x["g_lock"] for x in grp], 2),
                      "dir_resultant": circular_resultant([x["dir"] for x in grp]),
                      "f_s_p10": quantile([x["f_s"] for x in grp], 0.1), "f_s_median": quantile([x["f_s"] for x in grp], 0.5),
-                     "f_s_p90": quantile([x["f_s"] for x in grp], 0.9), "g_s_mean": mean([x["g_s"] for x in grp])}
+                     "f_s_p90": quantile([x["f_s"] for x in grp], 0.9), "g_s_mean": mean([x["g_s"] for x in grp]),
+                     "touching_share": mean([1.0 if x["touching"] else 0.0 for x in grp]),
+                     "touching_depth": mean([x["depth"] for x in grp if x["touching"]]),
+                     "apart_depth": mean([x["depth"] for x in grp if not x["touching"]])}
     out["depth_mean"] = (len(early) * out["early"]["depth_mean"] + len(late) * out["late"]["depth_mean"]) / n
+    out["records"] = {"early": early, "late": late}
     if entry is not None:
         dirs, finals = [], []
         for x in late:
@@ -182,6 +214,31 @@ def analyse_runs(rows, segments, mu, entry=None):
         out["entry"] = {"runs": len(dirs), "dir_resultant": circular_resultant(dirs),
                         "final_minus_entry_resultant": circular_resultant([f - d for f, d in zip(finals, dirs)])}
     return out
+
+
+def write_cdf_plot(out, directory, title):
+    """DIRECTORY/stop_distribution.dat (the empirical CDFs of the lock gauge and of the depth, early and late runs,
+    as four gnuplot index blocks) and stop_distribution.gp / .png: the lock gauge against t (stops along a path)
+    and t^2 (uniform over a region), and the depth. Raises OSError if a file cannot be written."""
+    os.makedirs(directory, exist_ok=True)
+    with open(os.path.join(directory, "stop_distribution.dat"), "w") as f:
+        for key in ("g_lock", "depth"):
+            for name in ("early", "late"):
+                v = sorted(x[key] for x in out["records"][name])
+                f.write(f"# {key} of the {name} runs: value, empirical CDF\n")
+                f.write("".join(f"{x:.6g} {(i + 1) / len(v):.6g}\n" for i, x in enumerate(v)) + "\n\n")
+    share = {k: out[k]["share"] * 100 for k in ("early", "late")}
+    write_plot(directory, "stop_distribution",
+               f"set multiplot layout 1,2 title '{title}'\nset key left top\nset xrange [0:1.6]\nset yrange [0:1]\n"
+               "set xlabel 'lock gauge g_lock (max over 26 .. 40 Hz)'\nset ylabel 'empirical CDF'\n"
+               f"plot 'stop_distribution.dat' index 0 with lines lw 2 title 'early runs ({share['early']:.1f} %)', "
+               f"'' index 1 with lines lw 2 title 'late runs ({share['late']:.1f} %)', "
+               "(x <= 1 ? x : 1) with lines dt 2 title 't (along a path)', (x <= 1 ? x * x : 1) with lines dt 3 "
+               "title 't^2 (uniform over the set)'\n"
+               "set xrange [0:2]\nset xlabel '|I_r| / r_lock'\n"
+               f"set arrow from {touching_floor() / out['r_lock']:.4f},0 to {touching_floor() / out['r_lock']:.4f},1 nohead dt 2\n"
+               "plot 'stop_distribution.dat' index 2 with lines lw 2 title 'early runs', '' index 3 with lines lw 2 "
+               "title 'late runs (dashed: floor of touching balls)'\nunset multiplot\n")
 
 
 def needed_late_depth(out, goal_depth):
@@ -205,6 +262,7 @@ def main():
     r.add_argument("--mu", type=float, required=True)
     r.add_argument("--entry", help="runs.csv of the same starts cut inside the band")
     r.add_argument("--goal", type=float, default=0.52, help="goal depth in r_lock (0.52: the robust goal)")
+    r.add_argument("--plot", help="write the CDFs and their plot (stop_distribution.png) into this directory")
     a = ap.parse_args()
     if a.cmd == "geometry":
         reach = euler_reach(a.mu, a.alpha_max)
@@ -231,9 +289,14 @@ def main():
             print(f"  {name:5s} {x['share'] * 100:5.1f} %: mean depth {x['depth_mean']:.3f} r_lock, lock gauge mean "
                   f"{x['g_lock_mean']:.3f} (KS from t {x['ks_path']:.3f}, from t^2 {x['ks_disc']:.3f}), stop speed "
                   f"p10 / median / p90 {x['f_s_p10']:.2f} / {x['f_s_median']:.2f} / {x['f_s_p90']:.2f} Hz, gauge there "
-                  f"{x['g_s_mean']:.3f}, direction resultant {x['dir_resultant']:.3f}")
+                  f"{x['g_s_mean']:.3f}, direction resultant {x['dir_resultant']:.3f}; close pairs {x['touching_share'] * 100:.1f} % "
+                  f"at {x['touching_depth']:.3f}, apart at {x['apart_depth']:.3f}")
+        print(f"  touching-pair floor {touching_floor() / out['r_lock']:.3f} r_lock ({touching_floor() / 1e-7:.2f}e-7)")
         print(f"  the late runs would need a mean depth of {needed_late_depth(out, a.goal):.3f} r_lock for "
               f"{a.goal} r_lock overall")
+        if a.plot:
+            write_cdf_plot(out, a.plot, f"{os.path.basename(os.path.dirname(os.path.abspath(a.runs_csv)))}, mu {a.mu}")
+            print(f"  plot: {os.path.join(a.plot, 'stop_distribution.png')}")
         if entry is not None:
             e = out["entry"]
             print(f"  entry ({e['runs']} late runs): direction resultant {e['dir_resultant']:.3f}; of final minus "

@@ -10,7 +10,8 @@ U plane with density 1 / ((2 pi)^2 (m L)^2 sin s*) per point (the share of the t
 the lemma |U| >= g(f) r_in(f) for every configuration in the set (random configurations and speeds); the
 Kolmogorov-Smirnov distance of a disc-uniform sample from t^2 and from t (1/4); the lock set contains the disc
 |U| <= r_lock. And one Monte Carlo of the robust design through abuopt (256 starts): the runs locked before the
-band are as many and as deep as uniform starts in the lock set, within binomial and sampling tolerances.
+band are as many and as deep as uniform starts in the lock set, within binomial and sampling tolerances; no
+close pair ends below the pair floor of its separation; the CDF plot's data has one line per run.
 """
 import cmath
 import math
@@ -80,6 +81,13 @@ def lock_set():
     disc = sum(1 for i in range(g) for j in range(g)
                if abs(sd.imbalance((2 * math.pi * (i + 0.5) / g, 2 * math.pi * (j + 0.5) / g))) <= sd.r_lock(mu)) / g / g
     check(disc <= x["share"] < 1, f"the lock set holds the disc |U| <= r_lock: {x['share']:.3f} >= {disc:.3f}")
+    check(abs(sd.CONTACT_SEPARATION - 0.2616) < 5e-5 and abs(sd.touching_floor() - 11.20e-7) < 0.005e-7,
+          f"contact distance {sd.CONTACT_SEPARATION:.4f} rad, touching-pair floor {sd.touching_floor() / 1e-7:.3f}e-7 "
+          "(docs/equilibrium_sets.md 5: 0.2616, 11.20)")
+    s = sd.CONTACT_SEPARATION
+    check(sd.is_touching((1.0, 1.0 + s + 0.039)) and sd.is_touching((6.2, 6.2 + s - 2 * math.pi))
+          and not sd.is_touching((1.0, 1.0 + s + 0.05)), "a close pair: within 0.04 rad of the contact distance, "
+          "across 2 pi too")
     check(x["unreached_share"] < x["share"] and x["unreached_depth_mean"] < x["depth_mean"],
           "the starts out of the Euler term's reach are fewer and deeper")
     check(abs(sd.euler_reach(0.03, 314.16) - 314.16 / (0.03 * (2 * math.pi * sd.F_N) ** 2)) < 1e-15
@@ -114,6 +122,18 @@ def monte_carlo(abuopt):
           "(3 standard errors of about 130 runs)")
     check(e["f_s_p90"] < 23 and out["late"]["f_s_p10"] > 28,
           f"early runs stop in the first ramp (p90 {e['f_s_p90']:.2f} Hz), late ones above 28 Hz")
+    close = [x for x in out["records"]["late"] if x["touching"]]
+    floor = lambda sep: abs(sd.MI * sd.E - 2 * sd.M_BALL * sd.L * math.cos(sep / 2))  # noqa: E731
+    check(len(close) > 20 and all(x["depth"] * sd.r_lock(0.03) >= floor(x["separation"]) * (1 - 1e-12) for x in close),
+          f"no close pair of the late runs ({len(close)}) ends below the pair floor |m_I e - 2 m L cos(s/2)| of its "
+          "separation")
+    with tempfile.TemporaryDirectory() as tmp:
+        sd.write_cdf_plot(out, tmp, "test")
+        blocks = open(os.path.join(tmp, "stop_distribution.dat")).read().split("\n\n\n")
+        sizes = [len([l for l in b.splitlines() if l and not l.startswith("#")]) for b in blocks if b.strip()]
+        n_e, n_l = len(out["records"]["early"]), len(out["records"]["late"])
+        check(sizes == [n_e, n_l, n_e, n_l], f"the CDF data has one line per run in each of its four blocks {sizes}")
+        check(os.path.exists(os.path.join(tmp, "stop_distribution.gp")), "the gnuplot script is written")
 
 
 def main(abuopt):
