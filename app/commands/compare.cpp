@@ -76,6 +76,7 @@ opt::ProblemSpec read_startup_profile_problem(YamlReader& r) {
   problems::StartupProfileProblem check(settings);  // a bad design is a ConfigError now, before any run
   spec.label = r.get_string_or("label", "startup_profile");
   spec.identity = check.identity();  // the archive id of `optimize` on the same sections
+  spec.validation_identity = check.validation_identity();  // a changed validation is computed anew
   // under mpirun every evaluation's Monte Carlo is spread over the ranks; the comparison's runs
   // (starts x solvers, `threads` at once) share them: their studies go into one pool of runs
   std::shared_ptr<BatchRunner> runner;

@@ -226,8 +226,9 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
       std::filesystem::create_directories(archive_dir, ec);
       if (ec) throw ConfigError("archive directory '" + archive_dir.string() + "' cannot be created: " + ec.message());
       if (spec.validate)
-        validation_archive =
-            std::make_unique<EvaluationArchive>((archive_dir / "validation.sqlite").string(), identity + "/validation");
+        validation_archive = std::make_unique<EvaluationArchive>(
+            (archive_dir / "validation.sqlite").string(),
+            identity + "/validation" + (spec.validation_identity.empty() ? "" : "/" + spec.validation_identity));
     }
     auto run_task = [&](std::size_t t) {
       const int k = static_cast<int>(t / setup.solvers.size());

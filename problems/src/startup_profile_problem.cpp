@@ -345,6 +345,13 @@ std::string StartupProfileProblem::identity_text() const {
   return text + identity_fields(settings_);
 }
 
+std::string StartupProfileProblem::validation_identity() const {
+  const ValidationSettings& v = settings_.validation;
+  std::string text = to_string(v.design);
+  if (v.design == InitialConditionKind::Grid) text += "/grid" + std::to_string(v.grid);
+  return text + "/runs" + std::to_string(v.runs) + "/seed" + std::to_string(v.seed);
+}
+
 std::string StartupProfileProblem::identity() const {
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(fnv1a64(identity_text())));

@@ -393,6 +393,21 @@ TEST(Comparison, ArchivesMakeAComparisonResumable) {
   EXPECT_TRUE(std::filesystem::exists(dir + "/a/sampled_hs071/start1-sao.sqlite"));
   EXPECT_TRUE(std::filesystem::exists(dir + "/a/sampled_hs071/validation.sqlite"));
 
+  // another validation (ProblemSpec::validation_identity, e.g. more runs): the runs still come from
+  // the archive, the validations are computed anew and stored beside the first ones
+  opt::ComparisonSetup other = setup_with(40, both, dir + "/a");
+  other.problems[0].validation_identity = "runs2048";
+  const opt::ComparisonResult revalidated = opt::run_comparison(other);
+  EXPECT_EQ(validated, 8);
+  for (const auto& run : revalidated.runs) {
+    EXPECT_EQ(run.result.archive_hits, run.result.evaluations) << run.solver << " " << run.start;
+    EXPECT_FALSE(run.validation_from_archive);
+  }
+  EXPECT_EQ(opt::run_comparison(other).runs.size(), 4u);  // and now answered: nothing validated
+  EXPECT_EQ(validated, 8);
+  EXPECT_EQ(opt::run_comparison(setup_with(40, both, dir + "/a")).runs.size(), 4u);  // the first ones kept
+  EXPECT_EQ(validated, 8);
+
   // cut short at 15 evaluations, then the full 40: the same runs as without any archive
   const opt::ComparisonResult cut = opt::run_comparison(setup_with(15, {"cobyla"}, dir + "/b"));
   const opt::ComparisonResult resumed = opt::run_comparison(setup_with(40, {"cobyla"}, dir + "/b"));

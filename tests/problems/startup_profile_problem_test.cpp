@@ -331,6 +331,15 @@ TEST(StartupProfileProblem, IdentityChangesWithWhatDecidesTheValues) {
   EXPECT_EQ(changed("{min: 15, max: 28, x0: 25}", "{min: 14, max: 28, x0: 20}"), base);
   EXPECT_EQ(changed("threads: 1", "threads: 2"), base);
   EXPECT_EQ(changed("montecarlo:", "validation: {runs: 64}\nmontecarlo:"), base);
+  // ... but they key the stored validations (ProblemSpec::validation_identity): a validation of
+  // another size, seed or design is never answered by one stored for this one.
+  auto validation_id = [&](const std::string& v) {
+    return StartupProfileProblem(settings_from(v + kThreeStep)).validation_identity();
+  };
+  EXPECT_EQ(validation_id(""), "random/runs1024/seed1");  // montecarlo seed 0 + 1
+  EXPECT_EQ(validation_id("validation: {runs: 8192}\n"), "random/runs8192/seed1");
+  EXPECT_EQ(validation_id("validation: {seed: 7, design: lhs, runs: 10}\n"), "lhs/runs10/seed7");
+  EXPECT_EQ(validation_id("validation: {design: grid, grid: 3}\n"), "grid/grid3/runs9/seed1");
   // Hard contact: a new identity, and it names the contact model's version, so that archives of an
   // older contact model (before the pivoting choice of modes) never answer for this one.
   const StartupProfileProblem contact(settings_from("abu: {ball_contact: hard}\n" + kThreeStep));

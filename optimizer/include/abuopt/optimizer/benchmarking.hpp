@@ -81,6 +81,11 @@ struct ProblemSpec {
   // a value stored under one identity never answers another. Give a hash of everything that fixes
   // the values (the startup problem: its archive id); empty: the label.
   std::string identity;
+  // What keys the stored out-of-sample values beside the identity: everything that fixes
+  // validate()'s values but not the problem's (the startup problem: its validation section's
+  // design, runs and seed), so a changed validation never answers from values stored for another.
+  // Empty: the identity alone keys them (a validate() that the identity fixes).
+  std::string validation_identity;
 };
 
 struct RunRecord;

@@ -241,6 +241,9 @@ class StartupProfileProblem : public opt::Problem {
   std::string identity_text() const;
   // "startup_profile-<16 hex digits of fnv1a64(identity_text())>": the archive's problem id.
   std::string identity() const;
+  // What fixes evaluate_out_of_sample() beside the identity: the validation section's design,
+  // grid (grid design only), runs and seed, as "random/runs1024/seed12" (keys stored validations).
+  std::string validation_identity() const;
 
  private:
   StartupProfileSettings settings_;
