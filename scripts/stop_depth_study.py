@@ -503,7 +503,7 @@ def oscillate(a):
     write_plot(a.out, "stop_depth_osc",
                f"set title 'oscillations through the band: mean |I_r| / r_lock(mu) per case ({a.runs} starts, "
                "contact hard)'\nset logscale x\nset xlabel 'peak rate of the profile after 25 Hz [Hz/s] (log)'\n"
-               "set ylabel 'mean |I_r| / r_lock(mu)'\nset yrange [0:*]\nset key top left\n"
+               "set ylabel 'mean |I_r| / r_lock(mu)'\nset yrange [0:*]\nset key bottom right\n"
                f"plot {plots}, {GOAL_FRACTION} with lines lw 2 lc rgb 'black' title 'goal 7.0e-7 = 0.44 r_lock'\n")
 
 
