@@ -25,7 +25,7 @@ kept; rerun the same command after an interruption):
      2003 profile's figures under the PI motor; from the ideal-motor design and the front's 8 and 11 s designs
   3c. formulation 2 with the drive's 1 Hz setpoints in the loop (PI motor, quantize_setpoint_1hz): bounded by the
      2003 profile's figures under that drive; a global phase (DIRECT_L, L1 penalty, 64 LHS starts) then COBYLA
-     from its best and from 3b's design
+     from its best and from the designs of 3b, 3 and the front's 8 s point
   4. formulation 3: robust over mu {0.02, 0.03, 0.04} and the imbalance +-20 %, from the best 19 s design
      of the sweep family; then, aimed at the robust goal, the objective at mu = 0.03 over the k6_sweep
      (configs/studies/f3_mu03.yaml), k4_hold (f3_mu03_k4.yaml) and release (f3_mu03_release.yaml) families
@@ -534,7 +534,7 @@ def main():
     n_designs = len(FAMILIES) + 1 + len(FRONT_T) + 1 + 1 + 1 + 1 + 1 + 1
     st.evals_total = (len(FAMILIES) * (g_evals + p_evals) + p_evals + len(FRONT_T) * front_evals + 1 +
                       (f2_starts + f2p_starts_n) * f2_evals + 1 + robust_evals + 2 * len(counts) * p_evals + q_evals
-                      + sum(g + 2 * p for g, _, p, _ in f3_budget.values()) + f2q_budget[0] + 2 * f2q_budget[2] + 2)
+                      + sum(g + 2 * p for g, _, p, _ in f3_budget.values()) + f2q_budget[0] + 4 * f2q_budget[2] + 2)
     n_designs += 2 * len(f3_budget)
     st.runs_total = ((n_designs + 1) * val_runs * 4 + 7 * (val_runs * 2 + (switch_runs * 2 if contact == "none" else 0))
                      + (len(DRIVE_MADE) + 1) * val_runs
@@ -634,10 +634,14 @@ def main():
 
     # 3c. Formulation 2 with the drive's 1 Hz setpoints in the loop: the designs of 3 and 3b lose to the 2003 profile
     # once their setpoints are rounded to whole Hz (section 8.3: the PI design's 29.28 / 29.22 Hz become 29 Hz), so
-    # the least T for the real drive is searched with it: a global phase, then COBYLA from its best and from 3b's design.
+    # the least T for the real drive is searched with it: a global phase, then COBYLA from its best and from the
+    # short designs of 3b, 3 and the front's 8 s point (the problem has local minima: from 3b's design 8.55 s, from
+    # 3's 6.1 s, section 8.3).
     st.stage("3c formulation 2 with PI + 1 Hz")
     designs["f2q_min_T"] = formulation2_pi1hz(st, config, f2_runs, f2q_budget,
-                                              [("pi_f2", designs["f2pi_min_T"]["result"]["best"]["x"])])
+                                              [("pi_f2", designs["f2pi_min_T"]["result"]["best"]["x"]),
+                                               ("ideal_f2", designs["f2_min_T"]["result"]["best"]["x"]),
+                                               ("front8", designs["f5_T8"]["result"]["best"]["x"])])
 
     # 4. Formulation 3: robust, from the best 19 s design of the sweep family.
     st.stage("4 formulation 3 (robust)")

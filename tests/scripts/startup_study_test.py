@@ -147,9 +147,10 @@ def end_to_end(abuopt, tmp):
           "kind: pi" in study.read(os.path.join(out, "best", "f2pi_min_T.yaml")),
           "formulation 2 with the PI motor: three starts, the PI motor in every optimised config and in its design")
     quantised = "kind: pi\n  quantize_setpoint_1hz: true"
-    # the polish from 3b's design runs when 3b found a feasible design (at this scale it may not: then its design is
-    # the 2003 profile, which has no design variables to start from)
-    q_starts = {"q_global"} | ({"q_pi_f2"} if any(r["feasible"] for r in s["f2_pi"]["steps"]) else set())
+    # the polishes from 3b's and 3's designs run when those found a feasible design (at this scale they may not: then
+    # the design is the 2003 profile, which has no design variables to start from); the front's 8 s design always
+    q_starts = ({"q_global", "q_front8"} | ({"q_pi_f2"} if any(r["feasible"] for r in s["f2_pi"]["steps"]) else set())
+                | ({"q_ideal_f2"} if any(r["feasible"] for r in s["f2"]["steps"]) else set()))
     check(s["f2_pi1hz"]["ref"]["runs"] == 5 and {r["start"] for r in s["f2_pi1hz"]["steps"]} == q_starts and
           all(quantised in study.read(os.path.join(out, d, "config.yaml"))
               for d in ["f2q_global", "f2_ref2003_pi1hz", "f2_ref2003_pi1hz_global"] + [f"f2_{n}" for n in q_starts]) and
