@@ -23,6 +23,9 @@ kept; rerun the same command after an interruption):
      19 s sweep design scaled to 8 s); the least feasible T over the starts
   3b. formulation 2 with the PI motor in the loop: the same least-T problem with `motor: pi`, bounded by the
      2003 profile's figures under the PI motor; from the ideal-motor design and the front's 8 and 11 s designs
+  3c. formulation 2 with the drive's 1 Hz setpoints in the loop (PI motor, quantize_setpoint_1hz): bounded by the
+     2003 profile's figures under that drive; a global phase (DIRECT_L, L1 penalty, 64 LHS starts) then COBYLA
+     from its best and from the designs of 3b, 3 and the front's 8 s point
   4. formulation 3: robust over mu {0.02, 0.03, 0.04} and the imbalance +-20 %, from the best 19 s design
      of the sweep family; then, aimed at the robust goal, the objective at mu = 0.03 over the k6_sweep
      (configs/studies/f3_mu03.yaml), k4_hold (f3_mu03_k4.yaml) and release (f3_mu03_release.yaml) families
@@ -64,6 +67,11 @@ VALIDATION_SEED = 9001
 SECOND_SEED = 9002  # a second fresh set: every design again at mu 0.02, the formulation-3 designs at mu 0.03
 REPORT_SEGMENTS = [(25.0, 1.0), (29.5, 10.0), (100.0, 8.0)]
 I_WITHOUT_BALLS = 5.6e-4 * 3.7e-3  # m_I e [kg m]
+PI_MOTOR = "motor:\n  kind: pi\n"
+QUANTISED_MOTOR = "motor:\n  kind: pi\n  quantize_setpoint_1hz: true\n"  # the drive's steering program: whole-Hz setpoints
+# Designs made with a drive in the loop: validated under that drive on both seeds, paired against the 2003 profile
+# under the same drive (row keys "pi" / "pi_1hz").
+DRIVE_MADE = {"f2pi_min_T": "pi", "f2q_min_T": "pi_1hz"}
 
 
 class Study:
@@ -352,11 +360,12 @@ def statistics_of(d):
     return out
 
 
-def paired_of(d_design, d_ref):
-    """Mean over the same starts of the design's |I_r| minus the reference's [1e-7 kg m], 95 % interval.
-    Both folders must come from the same seed, runs and ball count (the same initial angles, run by run)."""
+def paired_of(d_design, d_ref, col="ir_magnitude_kgm"):
+    """Mean over the same starts of the design's |I_r| (col "ir_x_kgm": I_r,x) minus the reference's [1e-7 kg m],
+    95 % interval. Both folders must come from the same seed, runs and ball count (the same initial angles, run by
+    run)."""
     def by_run(d):
-        return {r["index"]: float(r["ir_magnitude_kgm"]) / 1e-7
+        return {r["index"]: float(r[col]) / 1e-7
                 for r in csv.DictReader(open(os.path.join(d, "runs.csv"))) if r["status"] == "ok"}
     a, b = by_run(d_design), by_run(d_ref)
     v = [a[k] - b[k] for k in a if k in b]
@@ -427,6 +436,36 @@ def formulation2(st, front_text, runs, m03, p03, starts, evaluations):
     return best, rows
 
 
+def formulation2_pi1hz(st, config, f2_runs, budget, starts):
+    """Stage 3c: formulation 2 with the drive's 1 Hz setpoints in the loop (PI motor, quantize_setpoint_1hz in every
+    evaluation): the least T with mean |I_r| and %MI no worse than the 2003 profile's under that drive on the same
+    starts. budget = (global evaluations, global starts, polish evaluations). A global phase (DIRECT_L, L1 penalty,
+    on the global starts, bounded by the 2003 profile's figures on those starts; independent of any design), then
+    COBYLA (f2_runs starts) from the global best and from each (name, x) of starts. Returns the design entry."""
+    g_evals, g_runs, p_evals = budget
+
+    def ref(runs, name):
+        b = st.optimize(name, set_section_value(replace_section(config("f1_k3"), "motor", QUANTISED_MOTOR), "runs",
+                                                runs), 1)["best"]
+        return b["objective"], b["metrics"]["pct_mi"]
+
+    front = replace_section(config("f5_front"), "motor", QUANTISED_MOTOR)
+    mg, pg = ref(g_runs, "f2_ref2003_pi1hz_global")
+    g = st.optimize("f2q_global", global_config(formulation2_config(front, g_runs, mg, pg), g_runs, g_evals), g_evals)
+    m, p = ref(f2_runs, "f2_ref2003_pi1hz")
+    st.log(f"[f2 pi 1 Hz] the 2003 profile with the PI motor and 1 Hz setpoints on the {f2_runs} design starts: mean "
+           f"|I_r| {m:.3f}, %MI {p:.2f}; global best T {g['best']['metrics']['startup_time_s']:.3f} s (feasible "
+           f"{g['best']['feasible']} on {g_runs} starts)")
+    best, log = formulation2(st, front, f2_runs, m, p, [("q_global", g["best"]["x"])] +
+                             [(f"q_{n}", x) for n, x in starts if x], p_evals)
+    if best is None:
+        st.log("[f2 pi 1 Hz] no start reached a profile that meets both under that drive; its design is the 2003 profile")
+        best = {"best": {"objective": 19.0, "feasible": True, "x": {}, "profile": report_profile(),
+                         "metrics": {"startup_time_s": 19.0}}}
+    return {"result": best, "global": g, "formulation": "2q", "T": best["best"]["metrics"]["startup_time_s"],
+            "steps": log, "ref": {"mean": m, "pct_mi": p, "runs": f2_runs}}
+
+
 def main():
     ap = argparse.ArgumentParser(description="ADOPT startup-profile case study (issue 10)")
     ap.add_argument("--contact", choices=["hard", "none"], default="hard",
@@ -486,16 +525,19 @@ def main():
                                                max(4, int(128 * sc)), max(4, int(96 * sc)))
     f2_evals, f2_runs = max(2, int(40 * sc)), max(4, int(256 * sc))
     q_evals, q_runs = max(2, int(40 * sc)), max(4, int(128 * sc))  # PI + 1 Hz runs cost about 5 ideal-motor runs
+    # formulation 2 with PI + 1 Hz (stage 3c): global evaluations, global starts, polish evaluations (of f2_runs)
+    f2q_budget = (max(2, int(200 * sc)), max(4, int(64 * sc)), f2_evals)
     f2_starts = 4  # the front's 6, 8 and 11 s designs and the 19 s sweep design scaled to 8 s
     f2p_starts_n = 3  # with the PI motor: the ideal-motor design and the front's 8 and 11 s designs
     val_runs, switch_runs = a.val_runs, min(256, a.val_runs)
     counts = [] if a.skip_balls else list(range(2, 7))
-    n_designs = len(FAMILIES) + 1 + len(FRONT_T) + 1 + 1 + 1 + 1 + 1
+    n_designs = len(FAMILIES) + 1 + len(FRONT_T) + 1 + 1 + 1 + 1 + 1 + 1
     st.evals_total = (len(FAMILIES) * (g_evals + p_evals) + p_evals + len(FRONT_T) * front_evals + 1 +
                       (f2_starts + f2p_starts_n) * f2_evals + 1 + robust_evals + 2 * len(counts) * p_evals + q_evals
-                      + sum(g + 2 * p for g, _, p, _ in f3_budget.values()))
+                      + sum(g + 2 * p for g, _, p, _ in f3_budget.values()) + f2q_budget[0] + 4 * f2q_budget[2] + 2)
     n_designs += 2 * len(f3_budget)
-    st.runs_total = ((n_designs + 1) * val_runs * 4 + 6 * (val_runs * 2 + (switch_runs * 2 if contact == "none" else 0))
+    st.runs_total = ((n_designs + 1) * val_runs * 4 + 7 * (val_runs * 2 + (switch_runs * 2 if contact == "none" else 0))
+                     + (len(DRIVE_MADE) + 1) * val_runs
                      + len(counts) * 3 * val_runs + (2 * len(f3_budget) + 1) * val_runs)
     st.log(f"startup study, ball contact {contact}: {n_designs} designs, about {st.evals_total} evaluations and "
            f"{st.runs_total} validation runs; output {st.out}")
@@ -570,7 +612,7 @@ def main():
     # the real drive must be searched with the drive. COBYLA from the ideal-motor design and the front's 8
     # and 11 s designs.
     st.stage("3b formulation 2 with the PI motor")
-    pi_motor = "motor:\n  kind: pi\n"
+    pi_motor = PI_MOTOR
     ref_pi = set_section_value(replace_section(config("f1_k3"), "motor", pi_motor), "runs", f2_runs)
     r03p = st.optimize("f2_ref2003_pi", ref_pi, 1)["best"]
     m03p, p03p = r03p["objective"], r03p["metrics"]["pct_mi"]
@@ -589,6 +631,17 @@ def main():
     designs["f2pi_min_T"] = {"result": f2p_best, "formulation": "2pi",
                               "T": f2p_best["best"]["metrics"]["startup_time_s"], "steps": f2p_log,
                               "ref": {"mean": m03p, "pct_mi": p03p, "runs": f2_runs}}
+
+    # 3c. Formulation 2 with the drive's 1 Hz setpoints in the loop: the designs of 3 and 3b lose to the 2003 profile
+    # once their setpoints are rounded to whole Hz (section 8.3: the PI design's 29.28 / 29.22 Hz become 29 Hz), so
+    # the least T for the real drive is searched with it: a global phase, then COBYLA from its best and from the
+    # short designs of 3b, 3 and the front's 8 s point (the problem has local minima: from 3b's design 8.55 s, from
+    # 3's 6.1 s, section 8.3).
+    st.stage("3c formulation 2 with PI + 1 Hz")
+    designs["f2q_min_T"] = formulation2_pi1hz(st, config, f2_runs, f2q_budget,
+                                              [("pi_f2", designs["f2pi_min_T"]["result"]["best"]["x"]),
+                                               ("ideal_f2", designs["f2_min_T"]["result"]["best"]["x"]),
+                                               ("front8", designs["f5_T8"]["result"]["best"]["x"])])
 
     # 4. Formulation 3: robust, from the best 19 s design of the sweep family.
     st.stage("4 formulation 3 (robust)")
@@ -634,7 +687,7 @@ def main():
     # design tuned with the ideal motor can lose its advantage once its dwell frequency is rounded to
     # whole Hz (section 3 of the document). Family of the best 19 s design, COBYLA from it.
     st.stage("5b formulation 1 with PI + 1 Hz")
-    quantised = "motor:\n  kind: pi\n  quantize_setpoint_1hz: true\n"
+    quantised = QUANTISED_MOTOR
     qb = set_section_value(replace_section(config(fam19), "motor", quantised), "runs", q_runs)
     if a.f1_max_pct_mi != 2.0:
         qb = set_section_value(qb, "max_pct_mi", f"{a.f1_max_pct_mi:g}")
@@ -650,7 +703,7 @@ def main():
     os.makedirs(best_dir, exist_ok=True)
     table = {}
     # The motor and switch-model checks (the expensive ones) for the designs the document reports in full.
-    heavy = {"report_2003", best19, "f3_robust", "f5_T8", "f2_min_T", "f2pi_min_T", "f1_quantised"}
+    heavy = {"report_2003", best19, "f3_robust", "f5_T8", "f2_min_T", "f2pi_min_T", "f2q_min_T", "f1_quantised"}
     val_dir = os.path.join(st.out, "validation")
     for n, prof in profiles.items():
         title = f"startup study design {n}" if n != "report_2003" else "the 2003 report's final profile"
@@ -673,12 +726,23 @@ def main():
         table[n] = row
         if n not in heavy:
             continue
-        row["pi"] = st.montecarlo(n + "_pi", run_config(prof, title, motor="  kind: pi\n", contact=contact), val_runs,
-                                  VALIDATION_SEED)
-        row["pi_1hz"] = st.montecarlo(n + "_pi_1hz",
-                                      run_config(prof, title, motor="  kind: pi\n  quantize_setpoint_1hz: true\n",
-                                                 contact=contact),
-                                      val_runs, VALIDATION_SEED)
+        drives = {"pi": PI_MOTOR[len("motor:\n"):], "pi_1hz": QUANTISED_MOTOR[len("motor:\n"):]}
+        for key, motor in drives.items():
+            row[key] = st.montecarlo(f"{n}_{key}", run_config(prof, title, motor=motor, contact=contact), val_runs,
+                                     VALIDATION_SEED)
+        if n in DRIVE_MADE:  # under the drive it was made for: seed 9002 too, paired against 2003 on both seeds
+            key = DRIVE_MADE[n]
+            r2003 = table["report_2003"]
+            if key + "_s9002" not in r2003:
+                r2003[key + "_s9002"] = st.montecarlo(f"report_2003_{key}_s9002", run_config(
+                    profiles["report_2003"], "the 2003 report's final profile, ball contact " + contact,
+                    motor=drives[key], contact=contact), val_runs, SECOND_SEED)
+            row[key + "_s9002"] = st.montecarlo(f"{n}_{key}_s9002", run_config(prof, title, motor=drives[key],
+                                                                                contact=contact), val_runs, SECOND_SEED)
+            for sub in (key, key + "_s9002"):
+                for suffix, col in (("", "ir_magnitude_kgm"), ("_irx", "ir_x_kgm")):
+                    row[f"paired_{sub}{suffix}"] = paired_of(os.path.join(val_dir, f"{n}_{sub}"),
+                                                             os.path.join(val_dir, f"report_2003_{sub}"), col)
         if contact == "none":  # the switch model has no contact events: the check needs the report's model
             row["switch"] = st.montecarlo(n + "_switch", run_config(prof, title, method="switch_model"), switch_runs,
                                           VALIDATION_SEED)
@@ -690,6 +754,10 @@ def main():
     with open(os.path.join(best_dir, "f2pi_min_T.yaml"), "w") as f:  # made with the PI motor: runs with it
         f.write(run_config(profiles["f2pi_min_T"], f"startup study design f2pi_min_T (formulation 2 with the PI motor), "
                            f"ball contact {contact}", motor=pi_motor[len("motor:\n"):], contact=contact))
+    with open(os.path.join(best_dir, "f2q_min_T.yaml"), "w") as f:  # made with PI + 1 Hz: runs with it
+        f.write(run_config(profiles["f2q_min_T"], "startup study design f2q_min_T (formulation 2 with the PI motor and "
+                           f"1 Hz setpoints), ball contact {contact}", motor=QUANTISED_MOTOR[len("motor:\n"):],
+                           contact=contact))
 
     # Formulation 4's designs and the 2003 profile with the same balls, on the same fresh starts.
     balls = {}
@@ -834,7 +902,8 @@ def write_summary(st, designs, table, balls, best19):
         b = designs['f1_k3_local2003']['result']['best']
         lines.append(f"- f1_k3 polished from the 2003 profile: {b['objective']:.3f} (feasible {b['feasible']})")
     f2 = designs.get("f2_min_T")
-    for key, motor in (("f2_min_T", "ideal motor"), ("f2pi_min_T", "PI motor")):
+    for key, motor in (("f2_min_T", "ideal motor"), ("f2pi_min_T", "PI motor"),
+                       ("f2q_min_T", "PI motor with 1 Hz setpoints")):
         if key not in designs:
             continue
         f2 = designs[key]
@@ -846,6 +915,19 @@ def write_summary(st, designs, table, balls, best19):
         for s in f2["steps"]:
             lines.append(f"| {s['start']} | {s['T0']:.3f} | {s['T']:.3f} | {s['mean']:.3f} | {s['pct_mi']:.2f} | "
                          f"{s['feasible']} | {s['evaluations']} |")
+    made = [n for n in DRIVE_MADE if n in table]
+    if made:
+        lines += ["", "## Designs made with a drive in the loop, under that drive (paired against the 2003 profile "
+                  "under the same drive, same starts)", "",
+                  "| design | drive | seed | mean \\|I_r\\| | %MI \\|I_r\\| | mean I_r,x | vs 2003 \\|I_r\\| | "
+                  "vs 2003 I_r,x | 2003 mean \\|I_r\\| | 2003 %MI |", "|---|---|---|---|---|---|---|---|---|---|"]
+        for n in made:
+            key, r, ref = DRIVE_MADE[n], table[n], table["report_2003"]
+            for sub, seed in ((key, VALIDATION_SEED), (key + "_s9002", SECOND_SEED)):
+                lines.append(f"| {n} | {key} | {seed} | {fmt_ir(r[sub]['ir'])} | {fmt_mi(r[sub]['ir'])} | "
+                             f"{fmt_ir(r[sub]['irx'])} | {fmt_paired(r['paired_' + sub])} | "
+                             f"{fmt_paired(r['paired_' + sub + '_irx'])} | {fmt_ir(ref[sub]['ir'])} | "
+                             f"{fmt_mi(ref[sub]['ir'])} |")
     if balls:
         counts = sorted({k[0] for k in balls})
         lines += ["", f"## Ball count (equal total ball mass 2.8e-4 kg; {n_val} fresh starts per row, the 2003 profile "
@@ -869,6 +951,7 @@ def write_summary(st, designs, table, balls, best19):
     js = {"contact": st.a.contact, "best19": best19, "table": {n: {k: v for k, v in r.items()} for n, r in table.items()},
           "f2": {k: v for k, v in designs.get("f2_min_T", {}).items() if k in ("steps", "ref", "T")},
           "f2_pi": {k: v for k, v in designs.get("f2pi_min_T", {}).items() if k in ("steps", "ref", "T")},
+          "f2_pi1hz": {k: v for k, v in designs.get("f2q_min_T", {}).items() if k in ("steps", "ref", "T")},
           "stage_cost": st.stage_cost,
           "balls": {f"{k[0]}_{k[1]}": v for k, v in balls.items()}}
     with open(os.path.join(out, "summary.json"), "w") as f:

@@ -442,12 +442,17 @@ def main():
                                     f"{r['share_at_goal_depth']:.4f}\n")
                     f.write("\n\n")
                     series.append(f"{kind} to {f_h:g} Hz, mu {mu:g}")
+    # colour: the approach and hold (the same for every friction), line: up solid / down dashed, points: open for the
+    # first friction, filled for the second
+    colours = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b"]
+    per_mu = 2 * len(a.hold)
     plots = ", ".join(f"'stop_depth.dat' index {k} using 1:2 with linespoints lw 1.5 dt {1 if 'up' in s else 2} "
-                      f"pt {k % 13 + 1} title '{s}'" for k, s in enumerate(series))
+                      f"lc rgb '{colours[(k % per_mu) % len(colours)]}' pt {(6, 7, 4, 5)[min(k // per_mu, 3)]} "
+                      f"title '{s}'" for k, s in enumerate(series))
     write_plot(a.out, "stop_depth",
                f"set title 'mean |I_r| / r_lock(mu) against the approach duration ({a.runs} starts, contact hard)'\n"
                "set xrange [0.2:40]\nset xlabel 'approach duration D to the hold frequency [s] (log)'\nset logscale x\n"
-               "set ylabel 'mean |I_r| / r_lock(mu)'\nset yrange [0:1.4]\nset key outside right\n"
+               "set ylabel 'mean |I_r| / r_lock(mu)'\nset yrange [0:*]\nset key outside right\n"
                f"plot {plots}, {GOAL_FRACTION} with lines lw 2 lc rgb 'black' title 'goal 7.0e-7 = 0.44 r_lock'\n")
 
 
@@ -498,7 +503,7 @@ def oscillate(a):
     write_plot(a.out, "stop_depth_osc",
                f"set title 'oscillations through the band: mean |I_r| / r_lock(mu) per case ({a.runs} starts, "
                "contact hard)'\nset logscale x\nset xlabel 'peak rate of the profile after 25 Hz [Hz/s] (log)'\n"
-               "set ylabel 'mean |I_r| / r_lock(mu)'\nset yrange [0:*]\nset key top left\n"
+               "set ylabel 'mean |I_r| / r_lock(mu)'\nset yrange [0:*]\nset key bottom right\n"
                f"plot {plots}, {GOAL_FRACTION} with lines lw 2 lc rgb 'black' title 'goal 7.0e-7 = 0.44 r_lock'\n")
 
 

@@ -86,13 +86,17 @@ def unit(abuopt, tmp):
         os.makedirs(d, exist_ok=True)
         with open(os.path.join(d, "runs.csv"), "w") as f:
             w = csv.writer(f)
-            w.writerow(["index", "ir_magnitude_kgm", "status"])
-            for i, v in enumerate(vals):
-                w.writerow([i, (v if v is not None else 0.0) * 1e-7, "ok" if v is not None else "solver_failure"])
+            w.writerow(["index", "ir_magnitude_kgm", "ir_x_kgm", "status"])
+            for i, v in enumerate(vals):  # I_r,x: half of |I_r|
+                w.writerow([i, (v if v is not None else 0.0) * 1e-7, (v if v is not None else 0.0) * 0.5e-7,
+                            "ok" if v is not None else "solver_failure"])
     p = study.paired_of(a, b)
     # differences 2, 3, 4: mean 3, sd 1, half width 1.96 / sqrt(3); reference mean 2 -> +150 %
     check(p["n"] == 3 and abs(p["mean"] - 3.0) < 1e-12 and abs(p["hi"] - 3.0 - 1.96 / 3 ** 0.5) < 1e-12
           and abs(p["relative_pct"] - 150.0) < 1e-9, f"paired difference {p}")
+    px = study.paired_of(a, b, "ir_x_kgm")  # differences 1, 1.5, 2: mean 1.5, sd 0.5; reference mean 1 -> +150 %
+    check(px["n"] == 3 and abs(px["mean"] - 1.5) < 1e-12 and abs(px["hi"] - 1.5 - 0.98 / 3 ** 0.5) < 1e-12
+          and abs(px["relative_pct"] - 150.0) < 1e-9, f"paired difference of I_r,x {px}")
 
     # Stage 8's case counts (its ETA) against the grids of scripts/stop_depth_study.py: quick 2 x 2 x 3 x 4 approaches,
     # 2 x 8 oscillations, 2 x 2 x 2 x 2 releases; full: the published 96 and 576, and the two release scans.
@@ -123,7 +127,7 @@ def end_to_end(abuopt, tmp):
     f3_aimed = ({f"{n}_from_{start}" for n in ("f3_mu03", "f3_robust_k6") for start in ("global", "k6")}
                 | {"f3_mu03_k4_from_global", "f3_mu03_k4_from_k4", "f3_mu03_release_from_global",
                    "f3_mu03_release_from_scan"})
-    n_expected = 25  # 16 + the eight aimed formulation-3 designs + formulation 2 with the PI motor
+    n_expected = 26  # 16 + the eight aimed formulation-3 designs + formulation 2 with the PI motor and with PI + 1 Hz
     check(len(s["table"]) == n_expected and f3_aimed <= set(s["table"])
           and all(row["ideal"]["ok"] == 8 and row["s9002"]["ok"] == 8 for row in s["table"].values()),
           f"{len(s['table'])} designs validated on seeds 9001 and 9002, every run ok")
@@ -142,6 +146,24 @@ def end_to_end(abuopt, tmp):
           "kind: pi" in study.read(os.path.join(out, "f2_ref2003_pi", "config.yaml")) and
           "kind: pi" in study.read(os.path.join(out, "best", "f2pi_min_T.yaml")),
           "formulation 2 with the PI motor: three starts, the PI motor in every optimised config and in its design")
+    quantised = "kind: pi\n  quantize_setpoint_1hz: true"
+    # the polishes from 3b's and 3's designs run when those found a feasible design (at this scale they may not: then
+    # the design is the 2003 profile, which has no design variables to start from); the front's 8 s design always
+    q_starts = ({"q_global", "q_front8"} | ({"q_pi_f2"} if any(r["feasible"] for r in s["f2_pi"]["steps"]) else set())
+                | ({"q_ideal_f2"} if any(r["feasible"] for r in s["f2"]["steps"]) else set()))
+    check(s["f2_pi1hz"]["ref"]["runs"] == 5 and {r["start"] for r in s["f2_pi1hz"]["steps"]} == q_starts and
+          all(quantised in study.read(os.path.join(out, d, "config.yaml"))
+              for d in ["f2q_global", "f2_ref2003_pi1hz", "f2_ref2003_pi1hz_global"] + [f"f2_{n}" for n in q_starts]) and
+          "algorithm: direct_l" in study.read(os.path.join(out, "f2q_global", "config.yaml")) and
+          quantised in study.read(os.path.join(out, "best", "f2q_min_T.yaml")),
+          f"formulation 2 with PI + 1 Hz: a global phase and the polishes {sorted(q_starts)}, the drive in every optimised "
+          "config and in its design")
+    for n, key in (("f2pi_min_T", "pi"), ("f2q_min_T", "pi_1hz")):
+        row = s["table"][n]
+        check(all(row[k]["ok"] == 8 for k in (key, key + "_s9002")) and
+              all(row[f"paired_{k}{x}"]["n"] == 8 for k in (key, key + "_s9002") for x in ("", "_irx")) and
+              s["table"]["report_2003"][key + "_s9002"]["ok"] == 8,
+              f"{n}: validated under its drive ({key}) on seeds 9001 and 9002, paired against 2003, both definitions")
     for fam in ("approach", "oscillate", "release"):
         md = os.path.join(out, f"stop_depth_{fam}", "stop_depth" + ("" if fam == "approach" else "_osc" if fam ==
                                                                        "oscillate" else "_release") + ".md")
@@ -151,7 +173,7 @@ def end_to_end(abuopt, tmp):
           "formulation 2 minimises startup_time with the max_mean_abs_ir bound")
     cost = json.load(open(os.path.join(out, "stage_cost.json")))
     stages = [c["stage"] for c in cost]
-    check(len(stages) == 10 and all(c["cpu_s"] >= 0 and c["wall_s"] >= 0 for c in cost) and cost[0]["cpu_s"] > 0
+    check(len(stages) == 11 and all(c["cpu_s"] >= 0 and c["wall_s"] >= 0 for c in cost) and cost[0]["cpu_s"] > 0
           and "[cost] whole study: CPU" in r.stdout, f"the cost of every stage is recorded: {stages}")
     configs = [os.path.join(d, "config.yaml") for d in
                [os.path.join(out, x) for x in os.listdir(out)] + [os.path.join(out, "validation", x) for x in
