@@ -30,6 +30,23 @@ double angle_distance(double a, double b) {
   return std::min(d, 2 * M_PI - d);
 }
 
+// Runs two simulators from the same `runs` random two-ball starts (uniform angles, mt19937_64 with
+// `seed`) and counts the starts whose final angles agree within `tol` rad; every run must end ok.
+int starts_that_agree(const Simulator& a, const Simulator& b, unsigned seed, int runs, double tol) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 2 * M_PI);
+  int agree = 0;
+  for (int r = 0; r < runs; ++r) {
+    const std::vector<double> b0 = {u(rng), u(rng)};
+    const RunOutcome oa = a.run(b0), ob = b.run(b0);
+    EXPECT_TRUE(oa.ok()) << "start " << r << ": " << oa.message;
+    EXPECT_TRUE(ob.ok()) << "start " << r << ": " << ob.message;
+    const double d = std::max(angle_distance(oa.beta_final[0], ob.beta_final[0]), angle_distance(oa.beta_final[1], ob.beta_final[1]));
+    agree += d < tol;
+  }
+  return agree;
+}
+
 }  // namespace
 
 TEST(Simulator, NoBallsSteadyAmplitudeIsJeffcotts) {
@@ -152,45 +169,43 @@ TEST(Simulator, OneAndThreeBallUnitsBalanceOnTheReportProfile) {
 }
 
 TEST(Simulator, NativeAndArkodeBackendsAgree) {
-  std::mt19937_64 rng(11);
-  std::uniform_real_distribution<double> u(0, 2 * M_PI);
   SimulationSetup a, b;
   a.options.backend = IntegratorBackend::Native;
   b.options.backend = IntegratorBackend::ArkodeErk;
   a.options.rtol = b.options.rtol = 1e-8;
   a.options.atol = b.options.atol = 1e-11;
-  Simulator sa(a), sb(b);
-  int agree = 0;
-  const int runs = 6;
-  for (int r = 0; r < runs; ++r) {
-    const std::vector<double> b0 = {u(rng), u(rng)};
-    const RunOutcome oa = sa.run(b0), ob = sb.run(b0);
-    const double d = std::max(angle_distance(oa.beta_final[0], ob.beta_final[0]), angle_distance(oa.beta_final[1], ob.beta_final[1]));
-    agree += d < 1e-3;
+  const Simulator sa(a), sb(b);
+  EXPECT_EQ(starts_that_agree(sa, sb, 11, 6, 1e-3), 6);
+}
+
+// The switch model's right-hand side jumps where a ball's speed crosses the band, so a step across
+// a jump fails the error test until the step is below tol / jump: ARKODE's default of 7 error-test
+// failures (step cut to 0.3 each) stopped such runs with ARK_ERR_FAILURE; the native stepper cuts
+// without a count limit. With the limit raised (50, integrator_arkode.cpp) both back ends run the
+// switch model, without and with contact: every run ok, final angles within 0.05 rad on at least
+// 3 of 4 starts (the switch model's tolerance above; measured: 7 of the 8 within 0.011 rad, one
+// start with contact 0.41 rad apart, near resonance as in the tests below).
+TEST(Simulator, SwitchModelRunsOnTheArkodeBackend) {
+  for (const BallContact contact : {BallContact::None, BallContact::Hard}) {
+    SimulationSetup a, b;
+    a.abu.ball_contact = b.abu.ball_contact = contact;
+    a.options.method = b.options.method = FrictionMethod::SwitchModel;
+    a.options.switch_band = b.options.switch_band = 1e-4;
+    b.options.backend = IntegratorBackend::ArkodeErk;
+    const Simulator sa(a), sb(b);
+    EXPECT_GE(starts_that_agree(sa, sb, 23, 4, 0.05), 3) << "contact " << static_cast<int>(contact);
   }
-  EXPECT_EQ(agree, runs);
 }
 
 TEST(Simulator, EventDrivenAndSwitchModelAgreeOnMostInitialConditions) {
   // Stated tolerance: final angles within 0.05 rad for at least 10 of 12 initial conditions
   // (the switch model's band shifts transitions slightly; near resonance the system amplifies
   // such shifts, so a few runs may end elsewhere).
-  std::mt19937_64 rng(5);
-  std::uniform_real_distribution<double> u(0, 2 * M_PI);
   SimulationSetup a, b;
   b.options.method = FrictionMethod::SwitchModel;
   b.options.switch_band = 1e-5;
-  Simulator sa(a), sb(b);
-  int agree = 0;
-  const int runs = 12;
-  for (int r = 0; r < runs; ++r) {
-    const std::vector<double> b0 = {u(rng), u(rng)};
-    const RunOutcome oa = sa.run(b0), ob = sb.run(b0);
-    ASSERT_TRUE(ob.ok()) << ob.message;
-    const double d = std::max(angle_distance(oa.beta_final[0], ob.beta_final[0]), angle_distance(oa.beta_final[1], ob.beta_final[1]));
-    agree += d < 0.05;
-  }
-  EXPECT_GE(agree, 10);
+  const Simulator sa(a), sb(b);
+  EXPECT_GE(starts_that_agree(sa, sb, 5, 12, 0.05), 10);
 }
 
 TEST(Simulator, OutcomeIsConsistentAndRepeatable) {
