@@ -72,6 +72,9 @@ TEST(SaoPolish, ReachesTheCornerOfAPiecewiseConstantResponse) {
   const auto without = opt::minimize_sao(p2, o, opt::SaoOptions{});
   std::cout << "[measure] corner staircase, 80 evaluations: polish " << with.brief_report() << " at (" << with.x[0]
             << ", " << with.x[1] << "); no polish " << without.brief_report() << "\n";
+  std::cout << "[measure] messages: polish '" << with.message << "'; no polish '" << without.message << "'\n";
+  EXPECT_FALSE(same_history(with, without));  // the polish ran ...
+  EXPECT_NE(with.message.find("polish"), std::string::npos);  // ... and ended the run
   ASSERT_EQ(with.x.size(), 2u);
   EXPECT_EQ(with.x[0], 1.0);
   EXPECT_EQ(with.x[1], 0.0);
@@ -88,7 +91,7 @@ TEST(SaoPolish, ReachesTheCornerOfAPiecewiseConstantResponse) {
   while (same < std::min(with.history.size(), without.history.size()) &&
          with.history[same].x == without.history[same].x)
     ++same;
-  EXPECT_GE(same, 21u);  // at least the start and the global phase (10 + 10 points at 80 evaluations)
+  EXPECT_GE(same, 25u);  // at least the start and the global phase (4 (n + 1) = 12 + 12 points)
 }
 
 // Only sampled problems polish: a stochastic problem that is not sampled (the noisy benchmarks:
