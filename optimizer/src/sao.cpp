@@ -80,9 +80,19 @@ void SaoRun::run(const std::vector<double>& x0) {
   int stalled = 0;
   int failures_in_a_row = 0;  // steps rejected or with rho <= rho_shrink
   double streak_radius = radius_;  // the radius before the first of them
+  bool polished = false;  // the current trust region has handed over to the polish
   while (true) {
+    if (!polished && (radius_ < kPolishRadius || stalled >= sao_.stall_iterations) && polish_wanted()) {
+      if (!polish()) return;
+      polished = true;
+      radius_ = 0;  // converged: the restart (if any) follows
+      stalled = 0;
+    }
     if (radius_ < sao_.min_radius || stalled >= sao_.stall_iterations) {
-      if (radius_ < sao_.min_radius) {
+      if (polished) {
+        reason = TerminationReason::ConvergedXtol;
+        message = "the polish's step below " + format_number(kPolishRadius) + " of the ranges";
+      } else if (radius_ < sao_.min_radius) {
         reason = TerminationReason::ConvergedXtol;
         message = "trust region radius " + format_number(radius_) + " below min_radius " +
                   format_number(sao_.min_radius);
@@ -97,6 +107,7 @@ void SaoRun::run(const std::vector<double>& x0) {
       const std::optional<bool> restarted = restart();
       if (!restarted || !*restarted) return;
       ++restarts_;
+      polished = false;
       message += "; restart " + std::to_string(restarts_);
       stalled = 0;
       failures_in_a_row = 0;

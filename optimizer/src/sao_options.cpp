@@ -234,6 +234,7 @@ void describe_fields(FieldArchive& a, SaoGlobalPhase& o) {
   a.field("points", o.points, Rule::in_range(0, 100000));
   a.field("iterations", o.iterations, Rule::in_range(0, 100000));
   a.field("restart", o.restart);
+  a.field("polish", o.polish);
 }
 
 SaoOptions read_sao_options(YamlReader& r) {

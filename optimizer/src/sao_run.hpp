@@ -4,7 +4,8 @@
 // points of a region), sao_models.cpp (the surrogates), sao_subproblem.cpp (the sub-problem and the
 // penalty), sao_noise.cpp (the noise estimate of the ratio test), sao_global.cpp (the optional
 // global phase before the trust region), sao_noise_probe.cpp (noise detected from the data),
-// sao_sampling.cpp (the adaptive sample size).
+// sao_sampling.cpp (the adaptive sample size), sao_polish.cpp (the opt-in polish of a sampled
+// problem).
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -30,6 +31,10 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Once noise is detected from the data, designs per region hold this many times the automatic
 // point count (least squares over about twice the terms, as doe_points_factor 2 by hand).
 constexpr double kNoisyPointsFactor = 2.0;
+// The polish of a sampled problem (sao_polish.cpp): first step and smallest step, fractions of
+// each range; a trust region below kPolishRadius hands over to it.
+constexpr double kPolishStep = 0.1;
+constexpr double kPolishRadius = 1e-3;
 
 // One known point (evaluated in this run, or taken from an archive).
 struct KnownPoint {
@@ -205,6 +210,15 @@ class SaoRun {
   // Whether a converged trust region restarts: the global phase is on with `restart` and the
   // budget (max_evaluations > 0) has at least n + 2 evaluations left.
   bool restart_wanted() const;
+
+  // ---- polish of a sampled problem (sao_polish.cpp) ----
+  // Whether a trust region that shrank below kPolishRadius hands over to the polish: the global
+  // phase is on, the problem is sampled (a Monte Carlo: piecewise constant under common random
+  // numbers) and the sample size is final.
+  bool polish_wanted() const;
+  // Compass search on the exact merit from the incumbent (steps kPolishStep down to kPolishRadius,
+  // snapped to the bounds); the centre moves to its best point. false: stopped.
+  bool polish();
 
   // ---- noise (sao_noise.cpp does the arithmetic) ----
   double merit_noise(const Models& models, bool phase1) const;

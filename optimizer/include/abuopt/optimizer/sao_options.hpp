@@ -46,7 +46,9 @@ const std::vector<std::string>& subproblem_solver_names();
 // kriging models of the objective and of every constraint is largest; the trust region then starts
 // from the incumbent (the best point that satisfies the constraints). With `restart`, a trust
 // region that converges with budget left is followed by n + 1 more infill points and a new trust
-// region from the incumbent, until the budget is spent.
+// region from the incumbent, until the budget is spent. With `polish` (off by default), on a
+// sampled problem each trust region that shrinks below 1e-3 of the ranges (or stalls) ends in a
+// compass search.
 //
 // When it runs (`mode`): auto (default) on a stochastic problem (Problem::stochastic(): a Monte
 // Carlo, a noisy benchmark) or when `points` is given, else not; always; never.
@@ -60,6 +62,12 @@ struct SaoGlobalPhase {
   int points = 0;      // 0 (automatic) or >= 2
   int iterations = 0;  // >= 0; with points > 0 as given, else automatic
   bool restart = true;  // restart from the incumbent after convergence with budget left
+  // On a sampled problem (a Monte Carlo estimate: piecewise constant in the design under common
+  // random numbers), a trust region that shrinks below 1e-3 of the ranges or stalls hands over to
+  // a compass search on the exact merit that snaps to the bounds (docs/sao.md, "Polish on a
+  // sampled problem"). Off by default: it lowers the in-sample values but, measured on the large
+  // comparison, not the out-of-sample ones.
+  bool polish = false;
 
   // Whether the phase runs on a problem (stochastic: Problem::stochastic()).
   bool enabled(bool stochastic) const {
