@@ -5,6 +5,7 @@
     scripts/startup_study.py --contact none       # the report's model (balls may overlap): results/startup_study/
     scripts/startup_study.py --out DIR --threads 2 --abuopt build/app/abuopt
     scripts/startup_study.py --scale 4            # 4x the Monte Carlo runs and evaluations
+    scripts/startup_study.py --shake-balls 4      # stage 4c's last polish with 4 balls (default SHAKE_BALLS)
 
 --contact hard (the default) sets `abu.ball_contact: hard` in every optimised and validated config;
 --contact none leaves the configs as they are (docs/studies/startup-profile.md sections 1-6 are that
@@ -632,8 +633,9 @@ def main():
     f2_starts = 4  # the front's 6, 8 and 11 s designs and the 19 s sweep design scaled to 8 s
     f2p_starts_n = 3  # with the PI motor: the ideal-motor design and the front's 8 and 11 s designs
     val_runs, switch_runs = a.val_runs, min(256, a.val_runs)
-    # Stage 4c (evaluations, starts): one shake, two shakes, two shakes with --shake-balls balls. About 250 s of CPU at
-    # scale 1 (a run of these 14 - 17 s profiles at mu 0.03 costs about 2.0 ms with 2 balls, 5.2 ms with 6). The 2-ball
+    # Stage 4c (evaluations, starts): one shake, two shakes, two shakes with --shake-balls balls. 172 s of CPU at scale 1
+    # (measured, 6 balls; a run of these 14 - 18 s profiles at mu 0.03 costs about 2.0 ms with 2 balls, 5.2 ms with 6;
+    # docs/studies/startup-profile.md 8.8), its validation about 55 s more. The 2-ball
     # polishes on stage 4's 512 starts: its k4_hold design is feasible there (amplitude 0.5507 mm against the bound
     # 0.551), not on 256 (0.5513 with the shake: COBYLA found no feasible point in 80 evaluations); the budgets near
     # where the hand-made polishes had made most of their gain (two shakes: 13.60 of 13.56 at 60 of 150 evaluations).
@@ -996,8 +998,9 @@ def shake_validation(st, designs, table, profiles, nb):
             d = table[n]["mu0.03" if seed == VALIDATION_SEED else "mu0.03_s9002"]["ir"]
             rows.append({"design": n, "balls": 2, "seed": seed, "T": table[n]["T"], "mean": d["mean"], "lo": d["lo"],
                          "hi": d["hi"], "ref2003": ref, "paired": table[n]["paired" + sub], "x_better": ref / d["mean"],
-                         "x_better_2balls": ref / d["mean"],
-                         "in_sample": designs[n]["result"]["best"]["objective"]})
+                         "x_better_2balls": ref / d["mean"],  # in sample: only with the balls it was made with
+                         "in_sample": designs[n]["result"]["best"]["objective"] if designs[n].get("balls", 2) == 2
+                         else None})
     made = f"f3_mu03_shake2_balls{nb}"
     bl = equal_mass_balls(nb)
     cfg = {k: run_config(profiles[k], f"{k} with {nb} balls of equal total mass, ball contact {st.a.contact}",
@@ -1123,7 +1126,7 @@ def write_summary(st, designs, table, balls, best19, shake=None):
                   "| design | balls | T [s] | in-sample | seed | mean \\|I_r\\| mu 0.03 | 2003 mean (same balls) | vs 2003 | "
                   "x better than 2003 | x better than 2003 with 2 balls |", "|---|---|---|---|---|---|---|---|---|---|"]
         for r in shake["rows"]:
-            ins = "-" if r["in_sample"] is None else f"{r['in_sample']:.2f}"  # the 2-ball design with N balls: none
+            ins = "-" if r["in_sample"] is None else f"{r['in_sample']:.2f}"  # a design with other balls: none
             lines.append(f"| {r['design']} | {r['balls']} | {r['T']:.2f} | {ins} | {r['seed']} | "
                          f"{r['mean']:.2f} [{r['lo']:.2f}, {r['hi']:.2f}] | {r['ref2003']:.2f} | {fmt_paired(r['paired'])} | "
                          f"{r['x_better']:.3f} | {r['x_better_2balls']:.3f} |")
