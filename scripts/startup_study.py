@@ -555,6 +555,9 @@ def shake_chain(st, config, start, profile, budget, nb):
             st.log(f"[{name}] the start lies outside the family's bounds in {', '.join(clipped)}: clipped")
         r = st.optimize(name, set_x0(base, x0), evals)
         b = r["best"]
+        # the families run their constraints as a penalty (no declared constraints: "feasible" is always true), so
+        # feasibility is read from the constraint values g_<name> (relative, <= 0 when met)
+        b["feasible"] = all(v <= 1e-6 for k, v in b["metrics"].items() if k.startswith("g_")) and b["feasible"]
         st.log(f"[{name}] from {start if dwell == 0 else 'the previous design'}"
                f"{'' if dwell is None else ' with a shake'}: in sample {b['objective']:.3f} (feasible {b['feasible']}, "
                f"{runs} starts{f', {nb} balls' if dwell is None else ''}), T {b['metrics']['startup_time_s']:.2f} s")
