@@ -5,6 +5,7 @@
     scripts/startup_study.py --contact none       # the report's model (balls may overlap): results/startup_study/
     scripts/startup_study.py --out DIR --threads 2 --abuopt build/app/abuopt
     scripts/startup_study.py --scale 4            # 4x the Monte Carlo runs and evaluations
+    scripts/startup_study.py --shake-balls 4      # stage 4c's last polish with 4 balls (default SHAKE_BALLS)
 
 --contact hard (the default) sets `abu.ball_contact: hard` in every optimised and validated config;
 --contact none leaves the configs as they are (docs/studies/startup-profile.md sections 1-6 are that
@@ -32,14 +33,21 @@ kept; rerun the same command after an interruption):
      and, for comparison, k6_sweep over the spread (f3_robust_k6.yaml): each a global phase (DIRECT_L, L1
      penalty) and two polishes (COBYLA, from the global best and from formulation 1's design of the family;
      release: from the deepest case of the release scan)
+  4c. formulation 3: shakes at mu 0.03 (configs/studies/f3_mu03_shake1.yaml, f3_mu03_shake2.yaml), the chain
+     first made by hand in configs/studies/mu03/: from the better in sample of 4's two k4_hold designs, one shake
+     inserted into its dwell (insert_shake: 1.5 s in, 3 Hz down and back at the acceleration limit) and polished
+     (COBYLA 80 x 512 starts), a second shake inserted into the result's second dwell and polished (80 x 512), and
+     that polished again with --shake-balls balls of equal total mass (default SHAKE_BALLS; 60 x 256)
   5. formulation 4: the k4_hold family and the best 19 s design's family re-optimised per ball count
      (2..6 balls of equal total mass);
      the best 19 s design re-optimised with the PI motor and the drive's 1 Hz setpoints (f1_quantised)
   6. validation of every best design beside the 2003 profile on 1024 fresh random starts (seed 9001):
      ideal motor, at mu 0.03 and 0.04, PI motor, PI motor with 1 Hz setpoints; switch model on 256;
      every design again on a second fresh set (seed 9002), the formulation-3 designs also at mu 0.03;
-     the ball-count designs beside the 2003 profile with the same balls
-  7. summary.md, summary.json, best/*.yaml (ready to run), plots (profiles, front, final positions)
+     the ball-count designs beside the 2003 profile with the same balls; the shake designs of 4c (and their start)
+     at mu 0.03 on both seeds with "x better than 2003" figures, the one made with N balls also with those balls
+     beside the 2003 profile with them
+  7. summary.md, summary.json, best/*.yaml (ready to run), plots (profiles, front, final positions, the shakes)
   8. the stop-depth families of the limit analysis (scripts/stop_depth_study.py: approach, oscillate,
      release) into OUT/stop_depth_*: --stop-depth quick (default: a subset with the published deepest
      cases), full (the published grids of section 8.1, about 35 min of one core more) or none
@@ -72,6 +80,15 @@ QUANTISED_MOTOR = "motor:\n  kind: pi\n  quantize_setpoint_1hz: true\n"  # the d
 # Designs made with a drive in the loop: validated under that drive on both seeds, paired against the 2003 profile
 # under the same drive (row keys "pi" / "pi_1hz").
 DRIVE_MADE = {"f2pi_min_T": "pi", "f2q_min_T": "pi_1hz"}
+# Stage 4c, the shakes at mu 0.03 (docs/studies/startup-profile.md 8.1 "The floor of the locked runs", 8.4): each
+# shake is inserted SHAKE_OFFSET_S into a dwell, SHAKE_DEPTH_HZ down and back at the acceleration limit, as the x0
+# of configs/studies/mu03/f3_mu03_shake_polish.yaml and f3_mu03_shake2_polish.yaml were made by hand.
+SHAKE_OFFSET_S = 1.5
+SHAKE_DEPTH_HZ = 3.0
+SHAKE_RATE_MARGIN = 1.001  # 0.1 % inside the limit: x0 printed to 6 digits cannot start outside it
+# The ball count of the last polish of 4c (equal total ball mass, equal_mass_balls); --shake-balls. Set from the
+# robust helper's re-optimisation of the two-shake design with N = 3..6 balls (6 balls: 12.83 against 14.12 with 2).
+SHAKE_BALLS = 6
 
 
 class Study:
@@ -286,6 +303,56 @@ def with_contact(text, contact):
     return new
 
 
+def shake_duration(depth_hz, max_rate_hz_s=MAX_RATE_HZ_S):
+    """The duration of each half of a shake of depth_hz (down, then back up): an inclined sine of height H over dt
+    peaks at f' = 2 H / dt (f' = H / dt (1 - cos phi)), so at the acceleration limit dt = 2 H / max_rate, here
+    SHAKE_RATE_MARGIN longer (3 Hz: 0.12012 s at 50 Hz/s)."""
+    if depth_hz <= 0 or max_rate_hz_s <= 0:
+        raise ValueError(f"shake depth {depth_hz} Hz, rate {max_rate_hz_s} Hz/s: both must be > 0")
+    return SHAKE_RATE_MARGIN * 2.0 * depth_hz / max_rate_hz_s
+
+
+def dwells(segments, f0=0.0):
+    """Indices of the dwells (segments that end where they start) of [(end_frequency_hz, duration_s)] from f0."""
+    ends = [f0] + [f for f, _ in segments]
+    return [i for i in range(len(segments)) if segments[i][0] == ends[i]]
+
+
+def insert_shake(segments, index, offset_s, depth_hz, f0=0.0, max_rate_hz_s=MAX_RATE_HZ_S):
+    """A shake inserted into the dwell segments[index] (a profile [(end_frequency_hz, duration_s)] from f0 Hz):
+    the dwell at f is split offset_s after its start into (f, offset_s), (f - depth_hz, d), (f, d), (f, rest) with
+    d = shake_duration(depth_hz). The profile is unchanged up to the insertion, reaches f - depth_hz at its lowest,
+    and after the shake is the old one delayed by 2 d; the total duration grows by 2 d; the shake's peak |f'| is
+    max_rate_hz_s / SHAKE_RATE_MARGIN. Pure; ValueError if segments[index] is no dwell or offset_s is not inside it."""
+    if not 0 <= index < len(segments):
+        raise ValueError(f"shake index {index}: the profile has {len(segments)} segments")
+    f, dt = segments[index]
+    if index not in dwells(segments, f0):
+        raise ValueError(f"segment {index} ({f} Hz, {dt} s) is no dwell: a shake goes into a dwell")
+    if not 0 < offset_s < dt:
+        raise ValueError(f"shake offset {offset_s} s: must be inside the dwell's (0, {dt}) s")
+    if depth_hz >= f:
+        raise ValueError(f"shake depth {depth_hz} Hz: must be below the dwell's {f} Hz")
+    d = shake_duration(depth_hz, max_rate_hz_s)
+    return (list(segments[:index]) + [(f, offset_s), (f - depth_hz, d), (f, d), (f, dt - offset_s)]
+            + list(segments[index + 1:]))
+
+
+def design_x(segments, text):
+    """x (f<i>, dt<i> of segment i) of the config's free variables for a profile with the config's segments, clipped
+    into the config's bounds; returns (x, the names clipped)."""
+    n = len(re.findall(r"^    - ", text[re.search(r"^design:", text, re.M).start():], re.M))
+    if n != len(segments):
+        raise ValueError(f"the profile has {len(segments)} segments, the config's design {n}")
+    x, clipped = {}, []
+    for name, (lo, hi) in bounds_of(text).items():
+        v = segments[int(name.lstrip("dtf")) - 1][0 if name.startswith("f") else 1]
+        x[name] = min(max(v, lo), hi)
+        if x[name] != v:
+            clipped.append(name)
+    return x, clipped
+
+
 def equal_mass_balls(nb):
     """nb balls of the report's material with the total mass of its two (2.8e-4 kg): d ~ m^(1/3)."""
     m = 2.8e-4 / nb
@@ -466,6 +533,40 @@ def formulation2_pi1hz(st, config, f2_runs, budget, starts):
             "steps": log, "ref": {"mean": m, "pct_mi": p, "runs": f2_runs}}
 
 
+def shake_chain(st, config, start, profile, budget, nb):
+    """Stage 4c: from `start` (its profile), one shake inserted (insert_shake, into its first dwell) and polished
+    (configs/studies/f3_mu03_shake1.yaml), a second one inserted into the result's second dwell and polished
+    (f3_mu03_shake2.yaml), and that design polished again with nb balls of equal total mass. budget: three
+    (evaluations, starts). Returns the three design entries."""
+    out, prof = {}, profile
+    steps = (("f3_mu03_shake1", "f3_mu03_shake1", 0), ("f3_mu03_shake2", "f3_mu03_shake2", 1),
+             (f"f3_mu03_shake2_balls{nb}", "f3_mu03_shake2", None))
+    for (name, family, dwell), (evals, runs) in zip(steps, budget):
+        base = set_section_value(config(family), "runs", runs)
+        segs = segments_of(prof)
+        if dwell is not None:
+            f0 = prof.get("start_frequency_hz", 0.0)
+            k = dwells(segs, f0)[dwell]
+            segs = insert_shake(segs, k, min(SHAKE_OFFSET_S, segs[k][1] / 2), SHAKE_DEPTH_HZ, f0)
+        else:
+            base = with_balls(base, equal_mass_balls(nb))
+        x0, clipped = design_x(segs, base)
+        if clipped:
+            st.log(f"[{name}] the start lies outside the family's bounds in {', '.join(clipped)}: clipped")
+        r = st.optimize(name, set_x0(base, x0), evals)
+        b = r["best"]
+        # the families run their constraints as a penalty (no declared constraints: "feasible" is always true), so
+        # feasibility is read from the constraint values g_<name> (relative, <= 0 when met)
+        b["feasible"] = all(v <= 1e-6 for k, v in b["metrics"].items() if k.startswith("g_")) and b["feasible"]
+        st.log(f"[{name}] from {start if dwell == 0 else 'the previous design'}"
+               f"{'' if dwell is None else ' with a shake'}: in sample {b['objective']:.3f} (feasible {b['feasible']}, "
+               f"{runs} starts{f', {nb} balls' if dwell is None else ''}), T {b['metrics']['startup_time_s']:.2f} s")
+        out[name] = {"result": r, "formulation": 3, "T": b["metrics"]["startup_time_s"], "start": start,
+                     "balls": nb if dwell is None else 2}
+        prof, start = b["profile"], name
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description="ADOPT startup-profile case study (issue 10)")
     ap.add_argument("--contact", choices=["hard", "none"], default="hard",
@@ -483,6 +584,9 @@ def main():
                     help="formulation 1's bound on %%MI(|I_r|) (default 2, the goal, without contact; 4 with contact: "
                          "half the 2003 profile's %%MI under contact, see the document's section 8)")
     ap.add_argument("--skip-balls", action="store_true", help="skip formulation 4 (ball count)")
+    ap.add_argument("--shake-balls", type=int, default=SHAKE_BALLS,
+                    help=f"stage 4c's last polish of the two-shake design: this many balls of equal total mass "
+                         f"(default {SHAKE_BALLS})")
     ap.add_argument("--stop-depth", choices=["quick", "full", "none"], default="quick",
                     help="stage 8, the stop-depth families of the limit analysis (scripts/stop_depth_study.py): quick "
                          "(default, a subset with the published deepest cases, about 3 min of one core), full (the "
@@ -496,6 +600,8 @@ def main():
         sys.exit(f"--f1-max-pct-mi {a.f1_max_pct_mi}: must be in (0, 100]")
     if a.scale <= 0:
         sys.exit(f"--scale {a.scale}: must be > 0")
+    if a.shake_balls < 2:
+        sys.exit(f"--shake-balls {a.shake_balls}: must be >= 2")
     if a.val_runs < 2:
         sys.exit(f"--val-runs {a.val_runs}: must be >= 2")
     if not os.access(a.abuopt, os.X_OK):
@@ -530,15 +636,26 @@ def main():
     f2_starts = 4  # the front's 6, 8 and 11 s designs and the 19 s sweep design scaled to 8 s
     f2p_starts_n = 3  # with the PI motor: the ideal-motor design and the front's 8 and 11 s designs
     val_runs, switch_runs = a.val_runs, min(256, a.val_runs)
+    # Stage 4c (evaluations, starts): one shake, two shakes, two shakes with --shake-balls balls. 172 s of CPU at scale 1
+    # (measured, 6 balls; a run of these 14 - 18 s profiles at mu 0.03 costs about 2.0 ms with 2 balls, 5.2 ms with 6;
+    # docs/studies/startup-profile.md 8.8), its validation about 55 s more. The 2-ball
+    # polishes on stage 4's 512 starts: its k4_hold design is feasible there (amplitude 0.5507 mm against the bound
+    # 0.551), not on 256 (0.5513 with the shake: COBYLA found no feasible point in 80 evaluations); the budgets near
+    # where the hand-made polishes had made most of their gain (two shakes: 13.60 of 13.56 at 60 of 150 evaluations).
+    # With 6 balls the amplitude has a margin (0.538 mm) and a run costs 2.6 x: 256 starts.
+    shake_budget = ((max(2, int(80 * sc)), max(4, int(512 * sc))), (max(2, int(80 * sc)), max(4, int(512 * sc))),
+                    (max(2, int(60 * sc)), max(4, int(256 * sc))))
     counts = [] if a.skip_balls else list(range(2, 7))
     n_designs = len(FAMILIES) + 1 + len(FRONT_T) + 1 + 1 + 1 + 1 + 1 + 1
     st.evals_total = (len(FAMILIES) * (g_evals + p_evals) + p_evals + len(FRONT_T) * front_evals + 1 +
                       (f2_starts + f2p_starts_n) * f2_evals + 1 + robust_evals + 2 * len(counts) * p_evals + q_evals
                       + sum(g + 2 * p for g, _, p, _ in f3_budget.values()) + f2q_budget[0] + 4 * f2q_budget[2] + 2)
-    n_designs += 2 * len(f3_budget)
+    n_designs += 2 * len(f3_budget) + len(shake_budget)
+    st.evals_total += sum(e for e, _ in shake_budget)
     st.runs_total = ((n_designs + 1) * val_runs * 4 + 7 * (val_runs * 2 + (switch_runs * 2 if contact == "none" else 0))
                      + (len(DRIVE_MADE) + 1) * val_runs
-                     + len(counts) * 3 * val_runs + (2 * len(f3_budget) + 1) * val_runs)
+                     + len(counts) * 3 * val_runs + (2 * len(f3_budget) + 1 + len(shake_budget)) * val_runs
+                     + 6 * val_runs)  # the shake designs' mu 0.03 on seed 9002; 3 with N balls on 2 seeds
     st.log(f"startup study, ball contact {contact}: {n_designs} designs, about {st.evals_total} evaluations and "
            f"{st.runs_total} validation runs; output {st.out}")
 
@@ -665,6 +782,14 @@ def main():
             r = st.optimize(f"{name}_from_{start}", set_x0(base, x0), pe)
             designs[f"{name}_from_{start}"] = {"result": r, "formulation": 3, "T": 19, "global": g}
 
+    # 4c. Shakes at mu 0.03 (section 8.4): the chain first made by hand with configs/studies/mu03/, from the better
+    # in sample of 4b's two k4_hold designs: one shake inserted and polished, a second one inserted into the result
+    # and polished, and that polished again with --shake-balls balls of equal total mass.
+    st.stage("4c formulation 3: shakes at mu 0.03")
+    k4_start = min(("f3_mu03_k4_from_global", "f3_mu03_k4_from_k4"), key=score)
+    designs.update(shake_chain(st, config, k4_start, designs[k4_start]["result"]["best"]["profile"], shake_budget,
+                               a.shake_balls))
+
     st.stage("5 formulation 4 (ball count)")
     # 5. Formulation 4: the k4_hold family re-optimised per ball count at equal total ball mass (2.8e-4 kg,
     # same material), COBYLA from formulation 1's k4_hold design, formulation 1's constraints; and the
@@ -759,6 +884,8 @@ def main():
                            f"1 Hz setpoints), ball contact {contact}", motor=QUANTISED_MOTOR[len("motor:\n"):],
                            contact=contact))
 
+    shake = shake_validation(st, designs, table, profiles, a.shake_balls)
+
     # Formulation 4's designs and the 2003 profile with the same balls, on the same fresh starts.
     balls = {}
     for nb in counts:
@@ -787,7 +914,7 @@ def main():
                                                     "T": b["metrics"].get("startup_time_s"), "profile": b["profile"]})
 
     st.stage("7 summary and plots")
-    write_summary(st, designs, table, balls, best19)
+    write_summary(st, designs, table, balls, best19, shake)
     if a.stop_depth != "none":
         st.stage(f"8 stop depth ({a.stop_depth})")
         stop_depth_stage(st, a.stop_depth)
@@ -856,7 +983,55 @@ def stop_depth_stage(st, which):
         st.log(f"[stop depth {family}] {out}: stop_depth*.md, .csv, .png")
 
 
-def write_summary(st, designs, table, balls, best19):
+def shake_validation(st, designs, table, profiles, nb):
+    """Stage 6 for the designs of 4c (their rows of `table` hold them with 2 balls on seeds 9001 and 9002): the
+    design made with nb balls, and the two-shake design it was polished from, also with those balls beside the 2003
+    profile with them, at mu 0.03 on both seeds (best/ gets the first ready to run with them). Returns the rows of the summary's shake table: per design, balls and
+    seed the mean |I_r| at mu 0.03, the 2003 profile's on the same starts (same balls; with nb balls also the
+    report's two), the paired difference and "x better than 2003" (the 2003 mean over the design's)."""
+    names = [n for n in designs if n.startswith("f3_mu03_shake")]
+    if not names:
+        return {}
+    start = designs[names[0]]["start"]
+    val_dir = os.path.join(st.out, "validation")
+    rows = []
+    for n in [start] + names:
+        for seed, sub in ((VALIDATION_SEED, "_mu0.03"), (SECOND_SEED, "_mu0.03_s9002")):
+            ref = table["report_2003"]["mu0.03" if seed == VALIDATION_SEED else "mu0.03_s9002"]["ir"]["mean"]
+            d = table[n]["mu0.03" if seed == VALIDATION_SEED else "mu0.03_s9002"]["ir"]
+            rows.append({"design": n, "balls": 2, "seed": seed, "T": table[n]["T"], "mean": d["mean"], "lo": d["lo"],
+                         "hi": d["hi"], "ref2003": ref, "paired": table[n]["paired" + sub], "x_better": ref / d["mean"],
+                         "x_better_2balls": ref / d["mean"],  # in sample: only with the balls it was made with
+                         "in_sample": designs[n]["result"]["best"]["objective"] if designs[n].get("balls", 2) == 2
+                         else None})
+    made = f"f3_mu03_shake2_balls{nb}"
+    bl = equal_mass_balls(nb)
+    cfg = {k: run_config(profiles[k], f"{k} with {nb} balls of equal total mass, ball contact {st.a.contact}",
+                         balls=bl, contact=st.a.contact) for k in ("report_2003", "f3_mu03_shake2", made)}
+    with open(os.path.join(st.out, "best", made + ".yaml"), "w") as f:  # made with nb balls: runs with them
+        f.write(cfg[made])
+    for seed, sfx, sub in ((VALIDATION_SEED, "", "mu0.03"), (SECOND_SEED, "_s9002", "mu0.03_s9002")):
+        ref = st.montecarlo(f"shake_balls{nb}_report_2003_mu0.03{sfx}", cfg["report_2003"], st.a.val_runs, seed,
+                            ["--mu", "0.03"])
+        two = table["report_2003"][sub]["ir"]["mean"]
+        # the two-shake design (made with 2 balls) with nb balls too: what the polish with nb balls adds
+        for n in ("f3_mu03_shake2", made):
+            d = st.montecarlo(f"shake_balls{nb}_{n}_mu0.03{sfx}", cfg[n], st.a.val_runs, seed, ["--mu", "0.03"])
+            p = paired_of(os.path.join(val_dir, f"shake_balls{nb}_{n}_mu0.03{sfx}"),
+                          os.path.join(val_dir, f"shake_balls{nb}_report_2003_mu0.03{sfx}"))
+            rows.append({"design": n, "balls": nb, "seed": seed, "T": table[n]["T"], "mean": d["ir"]["mean"],
+                         "lo": d["ir"]["lo"], "hi": d["ir"]["hi"], "ref2003": ref["ir"]["mean"], "paired": p,
+                         "x_better": ref["ir"]["mean"] / d["ir"]["mean"], "x_better_2balls": two / d["ir"]["mean"],
+                         "in_sample": designs[n]["result"]["best"]["objective"] if n == made else None})
+    st.log(f"[shakes] at mu 0.03, {st.a.val_runs} fresh starts, the 2003 profile on the same starts:")
+    for r in rows:
+        st.log(f"[shakes] {r['design']} ({r['balls']} balls, seed {r['seed']}): {r['mean']:.2f} [{r['lo']:.2f}, "
+               f"{r['hi']:.2f}], 2003 {r['ref2003']:.2f}: {r['x_better']:.3f} x better than 2003 with the same balls"
+               + (f", {r['x_better_2balls']:.3f} x than 2003 with 2" if r["balls"] != 2 else ""))
+    return {"start": start, "balls": nb, "designs": names, "rows": rows}
+
+
+def write_summary(st, designs, table, balls, best19, shake=None):
     out = st.out
     n_val = table["report_2003"]["ideal"]["runs"]
     lines = [f"# Startup-profile study, ball contact {st.a.contact}: validation ({n_val} fresh random starts, seed "
@@ -946,6 +1121,18 @@ def write_summary(st, designs, table, balls, best19):
                 b = balls[(nb, "reoptimised_best")]
                 lines.append(f"| {nb} | {b['T']:.2f} | {b['in_sample']:.2f}{'' if b['feasible'] else ' (infeasible)'} | "
                              f"{fmt_ir(b['ir'])} | {fmt_mi(b['ir'])} | {fmt_paired(b['paired'])} |")
+    if shake:
+        lines += ["", f"## Shakes at mu 0.03 (stage 4c, from {shake['start']}; {n_val} fresh starts per seed, the 2003 "
+                  "profile on the same starts with the same balls)", "",
+                  "\"x better\": the 2003 profile's mean |I_r| over the design's (the robust goal: 1.5 x with the "
+                  "report's two balls).", "",
+                  "| design | balls | T [s] | in-sample | seed | mean \\|I_r\\| mu 0.03 | 2003 mean (same balls) | vs 2003 | "
+                  "x better than 2003 | x better than 2003 with 2 balls |", "|---|---|---|---|---|---|---|---|---|---|"]
+        for r in shake["rows"]:
+            ins = "-" if r["in_sample"] is None else f"{r['in_sample']:.2f}"  # a design with other balls: none
+            lines.append(f"| {r['design']} | {r['balls']} | {r['T']:.2f} | {ins} | {r['seed']} | "
+                         f"{r['mean']:.2f} [{r['lo']:.2f}, {r['hi']:.2f}] | {r['ref2003']:.2f} | {fmt_paired(r['paired'])} | "
+                         f"{r['x_better']:.3f} | {r['x_better_2balls']:.3f} |")
     with open(os.path.join(out, "summary.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     js = {"contact": st.a.contact, "best19": best19, "table": {n: {k: v for k, v in r.items()} for n, r in table.items()},
@@ -953,7 +1140,7 @@ def write_summary(st, designs, table, balls, best19):
           "f2_pi": {k: v for k, v in designs.get("f2pi_min_T", {}).items() if k in ("steps", "ref", "T")},
           "f2_pi1hz": {k: v for k, v in designs.get("f2q_min_T", {}).items() if k in ("steps", "ref", "T")},
           "stage_cost": st.stage_cost,
-          "balls": {f"{k[0]}_{k[1]}": v for k, v in balls.items()}}
+          "balls": {f"{k[0]}_{k[1]}": v for k, v in balls.items()}, "shake": shake or {}}
     with open(os.path.join(out, "summary.json"), "w") as f:
         json.dump(js, f, indent=1)
     make_plots(st, table, designs, best19)
@@ -1053,6 +1240,15 @@ def make_plots(st, table, designs, best19):
                         if st.a.contact == "none" else
                         "11.20 with lines dt 3 lw 1.5 lc rgb 'black' title 'pair floor 11.20 (balls touching)'"),
     }
+    shakes = [n for n in names if n.startswith("f3_mu03_shake")]
+    if shakes:  # stage 4c's chain: its start, the three designs and the 2003 profile
+        chain = ["report_2003", designs[shakes[0]]["start"]] + shakes
+        scripts["profiles_shake.png"] = (
+            f"set title 'stage 4c: shakes at mu 0.03 (ball contact {st.a.contact}), from {chain[1]}'\n"
+            "set xlabel 'time [s]'; set ylabel 'frequency [Hz]'; set xrange [0:20]; set yrange [20:32]; "
+            "set key bottom right\nplot " + ", ".join(
+                f"'profiles.dat' index {names.index(n)} with lines lw {3 if n == 'report_2003' else 1.5} title '{n}'"
+                for n in chain))
     for png, body in scripts.items():
         p = os.path.join(out, png.replace(".png", ".gp"))
         with open(p, "w") as f:

@@ -4,13 +4,13 @@
     startup_study_test.py ABUOPT unit          # default suite, a few seconds: the --contact plumbing
     startup_study_test.py ABUOPT end_to_end    # ctest -L long: the whole study at --scale 0.02, then resumed
 
-unit: every study config gets exactly one active `ball_contact: hard` with --contact hard and is left
-byte-identical with --contact none (so the no-contact study replays its archives); abuopt accepts
-the generated configs; the equal-mass ball sets have the closed-form masses and diameters; the paired
-difference is the mean of the run-by-run differences; an output folder of one contact setting is
-refused with the other.
-end_to_end: every stage runs and writes its outputs, every optimised and validated config carries the
-contact setting, and a second run replays every evaluation from the archives (nothing computed).
+unit: stage 4c's shake insertion against the profile it edits (shakes()); every study config gets exactly one
+active `ball_contact: hard` with --contact hard and is left byte-identical with --contact none (so the no-contact
+study replays its archives); abuopt accepts the generated configs; the equal-mass ball sets have the closed-form
+masses and diameters; the paired difference is the mean of the run-by-run differences; an output folder of one
+contact setting is refused with the other.
+end_to_end: every stage runs and writes its outputs (stage 4c with --shake-balls 3), every optimised and validated
+config carries the contact setting, and a second run replays every evaluation from the archives (nothing computed).
 """
 import csv
 import json
@@ -80,6 +80,8 @@ def unit(abuopt, tmp):
         ok = r.returncode == 0 and json.load(open(os.path.join(out, "summary.json")))["ok"] == 4
         check(ok, f"abuopt montecarlo runs the validation config with contact {contact} (4 balls)")
 
+    shakes(abuopt, tmp, cdir)
+
     # Paired difference: the mean of the run-by-run differences, over the runs ok in both.
     a, b = os.path.join(tmp, "pa"), os.path.join(tmp, "pb")
     for d, vals in ((a, [3.0, 5.0, 7.0, None]), (b, [1.0, 2.0, 3.0, 9.0])):
@@ -114,10 +116,60 @@ def unit(abuopt, tmp):
           "a --contact none folder is refused by --contact hard, nothing written")
 
 
+def shakes(abuopt, tmp, cdir):
+    """Stage 4c's shake insertion against the inclined-sine profile it edits: f(t) unchanged up to the insertion and
+    delayed by the shake's 2 d after it, the lowest point the requested depth below the dwell, the peak |f'| at the
+    acceleration limit (within SHAKE_RATE_MARGIN), and abuopt reading the families' x back as the same profile."""
+    segs = [(22.6222, 1.55852), (28.9129, 3.4931), (28.9129, 3.71217), (100.0, 5.08554)]  # contact_best_mu03_k4
+    new = study.insert_shake(segs, 2, 1.5, 3.0)
+    d = study.shake_duration(3.0)
+    t_ins, total = 1.55852 + 3.4931 + 1.5, sum(dt for _, dt in segs)
+    grid = [total * k / 4000 for k in range(4001)]
+    before = max(abs(study.frequency_at(new, t) - study.frequency_at(segs, t)) for t in grid if t <= t_ins)
+    after = max(abs(study.frequency_at(new, t + 2 * d) - study.frequency_at(segs, t)) for t in grid if t >= t_ins)
+    check(before < 1e-12 and after < 1e-9, f"f(t) unchanged before the shake ({before:.1e}), delayed by 2 d after it "
+          f"({after:.1e})")
+    fine = [t_ins + 2 * d * k / 2000 for k in range(2001)]  # k = 1000: the end of the way down
+    low = min(study.frequency_at(new, t) for t in fine)
+    rate = max(abs(study.frequency_at(new, b) - study.frequency_at(new, a)) / (b - a) for a, b in zip(fine, fine[1:]))
+    check(abs(low - (28.9129 - 3.0)) < 1e-9, f"the shake reaches 3 Hz below the dwell ({low:.6f} Hz)")
+    check(study.MAX_RATE_HZ_S / study.SHAKE_RATE_MARGIN * 0.9999 < rate <= study.MAX_RATE_HZ_S,
+          f"the shake's peak f' {rate:.4f} Hz/s at the acceleration limit {study.MAX_RATE_HZ_S:.4f}")
+    check(abs(sum(dt for _, dt in new) - (total + 2 * d)) < 1e-12 and abs(d - 0.12 * study.SHAKE_RATE_MARGIN) < 1e-4
+          and len(new) == 7 and study.dwells(new) == [2, 5], f"7 segments, total {total:.5f} + 2 x {d:.5f} s")
+    for args, what in (((segs, 1, 1.0, 3.0), "a ramp"), ((segs, 2, 0.0, 3.0), "offset 0"),
+                       ((segs, 2, 3.71217, 3.0), "offset = the dwell"), ((segs, 2, 1.5, 28.9129), "depth = f"),
+                       ((segs, 4, 1.5, 3.0), "index out of range")):
+        try:
+            study.insert_shake(*args)
+            check(False, f"insert_shake refuses {what}")
+        except ValueError:
+            check(True, f"insert_shake refuses {what}")
+    # The two-shake profile in the families' bounds (no clipping), and abuopt reads x back as that profile.
+    two = study.insert_shake(new, 5, 1.5, 3.0)
+    for name, prof in (("f3_mu03_shake1", new), ("f3_mu03_shake2", two)):
+        text = study.set_section_value(study.read(os.path.join(cdir, name + ".yaml")), "runs", 4)
+        x, clipped = study.design_x(prof, text)
+        bnd = study.bounds_of(text)
+        check(not clipped and len(x) == {7: 11, 10: 16}[len(prof)]
+              and all(bnd[k][0] <= v <= bnd[k][1] for k, v in x.items()), f"{name}: x0 of {len(x)} variables in bounds")
+        cfg = os.path.join(tmp, name + ".yaml")
+        with open(cfg, "w") as f:
+            f.write(study.set_x0(text, x))
+        r = subprocess.run([abuopt, "optimize", cfg, "--out", os.path.join(tmp, name), "--max-evaluations", "1",
+                            "--threads", "1"], capture_output=True, text=True)
+        best = json.load(open(os.path.join(tmp, name, "result.json")))["best"] if r.returncode in (0, 3) else {}
+        got = study.segments_of(best["profile"]) if best else []
+        same = len(got) == len(prof) and all(abs(a - b) <= 1e-5 * b for p, q in zip(got, prof) for a, b in zip(p, q))
+        check(same and best["metrics"]["peak_angular_acceleration_rad_s2"] <= 314.16,
+              f"{name}: abuopt evaluates the inserted profile (peak "
+              f"{best.get('metrics', {}).get('peak_angular_acceleration_rad_s2')} rad/s^2)")
+
+
 def end_to_end(abuopt, tmp):
     out = os.path.join(tmp, "study")
     cmd = [sys.executable, SCRIPT, "--abuopt", abuopt, "--out", out, "--scale", "0.02", "--val-runs", "8",
-           "--threads", "2", "--nice", "0"]
+           "--threads", "2", "--nice", "0", "--shake-balls", "3"]
     r = subprocess.run(cmd, capture_output=True, text=True)
     check(r.returncode == 0, f"the study runs end to end (status {r.returncode}) {r.stderr[-2000:]}")
     if r.returncode != 0:
@@ -126,8 +178,10 @@ def end_to_end(abuopt, tmp):
     check(s["contact"] == "hard", "summary.json records contact hard")
     f3_aimed = ({f"{n}_from_{start}" for n in ("f3_mu03", "f3_robust_k6") for start in ("global", "k6")}
                 | {"f3_mu03_k4_from_global", "f3_mu03_k4_from_k4", "f3_mu03_release_from_global",
-                   "f3_mu03_release_from_scan"})
-    n_expected = 26  # 16 + the eight aimed formulation-3 designs + formulation 2 with the PI motor and with PI + 1 Hz
+                   "f3_mu03_release_from_scan"}
+                | {"f3_mu03_shake1", "f3_mu03_shake2", "f3_mu03_shake2_balls3"})
+    # 16 + the eight aimed formulation-3 designs + formulation 2 with the PI motor and with PI + 1 Hz + the 3 shakes
+    n_expected = 29
     check(len(s["table"]) == n_expected and f3_aimed <= set(s["table"])
           and all(row["ideal"]["ok"] == 8 and row["s9002"]["ok"] == 8 for row in s["table"].values()),
           f"{len(s['table'])} designs validated on seeds 9001 and 9002, every run ok")
@@ -164,6 +218,21 @@ def end_to_end(abuopt, tmp):
               all(row[f"paired_{k}{x}"]["n"] == 8 for k in (key, key + "_s9002") for x in ("", "_irx")) and
               s["table"]["report_2003"][key + "_s9002"]["ok"] == 8,
               f"{n}: validated under its drive ({key}) on seeds 9001 and 9002, paired against 2003, both definitions")
+    sh = s["shake"]
+    rows = {(r["design"], r["balls"], r["seed"]) for r in sh["rows"]}
+    chain = [sh["start"], "f3_mu03_shake1", "f3_mu03_shake2", "f3_mu03_shake2_balls3"]
+    check(sh["balls"] == 3 and sh["start"] in ("f3_mu03_k4_from_global", "f3_mu03_k4_from_k4") and
+          rows == {(n, 2, seed) for n in chain for seed in (9001, 9002)}
+          | {(n, 3, seed) for n in ("f3_mu03_shake2", "f3_mu03_shake2_balls3") for seed in (9001, 9002)}
+          and all(r["x_better"] > 0 and r["paired"]["n"] == 8 for r in sh["rows"]),
+          f"stage 4c: its start and three designs at mu 0.03 on both seeds, the last also with 3 balls ({len(rows)} rows)")
+    s1, s2 = (study.read(os.path.join(out, n, "config.yaml")) for n in ("f3_mu03_shake1", "f3_mu03_shake2"))
+    s3, b3 = (study.read(p) for p in (os.path.join(out, "f3_mu03_shake2_balls3", "config.yaml"),
+                                      os.path.join(out, "best", "f3_mu03_shake2_balls3.yaml")))
+    check(len(study.bounds_of(s1)) == 11 and len(study.bounds_of(s2)) == 16 and "friction_mu: 0.03" in s2
+          and all(len(re.findall(r"^    - \{mass_kg", x, re.M)) == 3 for x in (s3, b3))
+          and not re.search(r"mass_kg", s2), "stage 4c: one and two shakes, the last polish and its best/ config with 3 balls")
+    check("## Shakes at mu 0.03" in study.read(os.path.join(out, "summary.md")), "summary.md has the shake table")
     for fam in ("approach", "oscillate", "release"):
         md = os.path.join(out, f"stop_depth_{fam}", "stop_depth" + ("" if fam == "approach" else "_osc" if fam ==
                                                                        "oscillate" else "_release") + ".md")
@@ -173,7 +242,7 @@ def end_to_end(abuopt, tmp):
           "formulation 2 minimises startup_time with the max_mean_abs_ir bound")
     cost = json.load(open(os.path.join(out, "stage_cost.json")))
     stages = [c["stage"] for c in cost]
-    check(len(stages) == 11 and all(c["cpu_s"] >= 0 and c["wall_s"] >= 0 for c in cost) and cost[0]["cpu_s"] > 0
+    check(len(stages) == 12 and all(c["cpu_s"] >= 0 and c["wall_s"] >= 0 for c in cost) and cost[0]["cpu_s"] > 0
           and "[cost] whole study: CPU" in r.stdout, f"the cost of every stage is recorded: {stages}")
     configs = [os.path.join(d, "config.yaml") for d in
                [os.path.join(out, x) for x in os.listdir(out)] + [os.path.join(out, "validation", x) for x in
@@ -183,7 +252,7 @@ def end_to_end(abuopt, tmp):
     check(len(configs) > 60 and not bad, f"all {len(configs)} configs run carry ball_contact: hard {bad[:3]}")
     check(active_contact_lines(study.read(os.path.join(out, "best", "best_19s.yaml"))) == ["hard"],
           "best/best_19s.yaml is ready to run with contact")
-    for png in ("front.png", "profiles.png", "profiles_full.png"):
+    for png in ("front.png", "profiles.png", "profiles_full.png", "profiles_shake.png"):
         check(os.path.getsize(os.path.join(out, png)) > 1000 if os.path.exists(os.path.join(out, png)) else False,
               f"{png} drawn")
     r2 = subprocess.run(cmd, capture_output=True, text=True)
