@@ -88,7 +88,7 @@ void apply_overrides(const MonteCarloArgs& a, MonteCarloConfig& cfg) {
     s.uncertain.friction.sampling = FrictionSampling::Fixed;
     s.uncertain.friction.value = *a.mu;
   }
-  validate(s);
+  validate(s, "montecarlo");  // the config as the options left it (read unchecked, so options can fix it)
 }
 
 std::string friction_text(const MonteCarloStudy& s) {
@@ -164,7 +164,7 @@ PlotStatus write_outputs(const std::string& dir, const MonteCarloResult& result,
 int run_montecarlo(const MonteCarloArgs& a) {
   YamlReader root = YamlReader::load_file(a.config);
   SimulationSetup setup = read_simulation_setup(root);
-  MonteCarloConfig cfg = read_monte_carlo_config(root, std::move(setup));
+  MonteCarloConfig cfg = read_monte_carlo_config_unchecked(root, std::move(setup));
   root.finish();
   apply_overrides(a, cfg);
   std::optional<OutputDirLock> lock;  // one run per output directory

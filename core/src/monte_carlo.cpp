@@ -218,11 +218,25 @@ void describe_montecarlo_fields(FieldArchive& a, MonteCarloStudy& st, std::size_
 
 void describe_fields(FieldArchive& a, MonteCarloConfig& c) { describe_montecarlo_fields(a, c.study, c.threads); }
 
-MonteCarloConfig read_monte_carlo_config(YamlReader& root, SimulationSetup setup) {
+namespace {
+
+MonteCarloConfig read_section(YamlReader& mc, SimulationSetup setup) {
   MonteCarloConfig cfg;
   cfg.study.setup = std::move(setup);
-  YamlReader mc = root.child("montecarlo");
   read_fields(mc, cfg);
+  return cfg;
+}
+
+}  // namespace
+
+MonteCarloConfig read_monte_carlo_config_unchecked(YamlReader& root, SimulationSetup setup) {
+  YamlReader mc = root.child("montecarlo");
+  return read_section(mc, std::move(setup));
+}
+
+MonteCarloConfig read_monte_carlo_config(YamlReader& root, SimulationSetup setup) {
+  YamlReader mc = root.child("montecarlo");
+  MonteCarloConfig cfg = read_section(mc, std::move(setup));
   validate(cfg.study, mc.path());
   return cfg;
 }

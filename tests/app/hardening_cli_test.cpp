@@ -196,5 +196,27 @@ TEST(HardeningCli, AFailedComputationSaysWhyOnStderr) {
   EXPECT_HAS(r.output, "abuopt: every run failed (4 of 4");
 }
 
+// Found by a study helper: with no montecarlo section the default design is the grid, whose grid^balls
+// runs exceed the run cap from 5 balls on (32^5 = 2^25); the options that replace the design were applied
+// only after that check, so `--design random --runs 16` could not rescue the config. Now the config is
+// checked as the options leave it, and without them the message still names the key and the cap.
+TEST(HardeningCli, OptionsCanReplaceADefaultGridThatIsTooLarge) {
+  const std::string ball = "    - {mass_kg: 5.6e-05, diameter_m: 0.00221}\n";
+  std::string five;
+  for (int i = 0; i < 5; ++i) five += ball;
+  const std::string two = "  balls:\n    - {mass_kg: 1.4e-4, diameter_m: 3.0e-3}\n"
+                          "    - {mass_kg: 1.4e-4, diameter_m: 3.0e-3}\n";
+  const std::string cfg = config_with(kSim, two, "  balls:\n" + five, "hardening_five_balls.yaml");
+  auto r = run_abuopt("montecarlo " + cfg + " --design random --runs 16 --seed 1 --json");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_HAS(r.output, "\"runs\": 16");
+  r = run_abuopt("montecarlo " + cfg);
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_HAS(r.output, "montecarlo.runs = 33554432");  // 32^5, the default grid
+  EXPECT_HAS(r.output, "10000000");
+  r = run_abuopt("montecarlo " + cfg + " --grid 2");  // 2^5 = 32 runs: the grid option alone is enough
+  EXPECT_EQ(r.status, 0) << r.output;
+}
+
 }  // namespace
 }  // namespace abuopt

@@ -155,6 +155,10 @@ struct MonteCarloConfig {
 // `setup` (read before, e.g. by read_simulation_setup) becomes study.setup. Validates the study.
 // The caller still calls root.finish().
 MonteCarloConfig read_monte_carlo_config(YamlReader& root, SimulationSetup setup);
+// The same without the structural check (grid^balls = runs, the run cap, the uncertain parameters): for a
+// caller that replaces some values first (the command line's --design/--runs/--grid) and then calls
+// validate(cfg.study, "montecarlo"). Each field's own rule is still checked as it is read.
+MonteCarloConfig read_monte_carlo_config_unchecked(YamlReader& root, SimulationSetup setup);
 
 extern const EnumNames<InitialConditionKind> kInitialConditionKindNames;  // grid, random, lhs, halton, sobol
 
