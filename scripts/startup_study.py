@@ -36,8 +36,10 @@ kept; rerun the same command after an interruption):
   4c. formulation 3: shakes at mu 0.03 (configs/studies/f3_mu03_shake1.yaml, f3_mu03_shake2.yaml), the chain
      first made by hand in configs/studies/mu03/: from the better in sample of 4's two k4_hold designs, one shake
      inserted into its dwell (insert_shake: 1.5 s in, 3 Hz down and back at the acceleration limit) and polished
-     (COBYLA 80 x 512 starts), a second shake inserted into the result's second dwell and polished (80 x 512), and
-     that polished again with --shake-balls balls of equal total mass (default SHAKE_BALLS; 60 x 256)
+     (COBYLA 80 x 512 starts), a second shake inserted into the result's second dwell and polished (80 x 512),
+     that polished again with --shake-balls balls of equal total mass (default SHAKE_BALLS; 60 x 256), and last
+     the deep excursion: that design's first excursion made a fall to each of DEEP_BOTTOMS_HZ and back at the
+     acceleration limit, run on 512 starts with those balls; the best within the bounds is kept if it beats it
   5. formulation 4: the k4_hold family and the best 19 s design's family re-optimised per ball count
      (2..6 balls of equal total mass);
      the best 19 s design re-optimised with the PI motor and the drive's 1 Hz setpoints (f1_quantised)
@@ -45,8 +47,8 @@ kept; rerun the same command after an interruption):
      ideal motor, at mu 0.03 and 0.04, PI motor, PI motor with 1 Hz setpoints; switch model on 256;
      every design again on a second fresh set (seed 9002), the formulation-3 designs also at mu 0.03;
      the ball-count designs beside the 2003 profile with the same balls; the shake designs of 4c (and their start)
-     at mu 0.03 on both seeds with "x better than 2003" figures, the one made with N balls also with those balls
-     beside the 2003 profile with them
+     at mu 0.03 on both seeds with "x better than 2003" figures, the two made with N balls (the polish and the deep
+     excursion) also with those balls beside the 2003 profile with them
   7. summary.md, summary.json, best/*.yaml (ready to run), plots (profiles, front, final positions, the shakes)
   8. the stop-depth families of the limit analysis (scripts/stop_depth_study.py: approach, oscillate,
      release) into OUT/stop_depth_*: --stop-depth quick (default: a subset with the published deepest
@@ -86,6 +88,12 @@ DRIVE_MADE = {"f2pi_min_T": "pi", "f2q_min_T": "pi_1hz"}
 SHAKE_OFFSET_S = 1.5
 SHAKE_DEPTH_HZ = 3.0
 SHAKE_RATE_MARGIN = 1.001  # 0.1 % inside the limit: x0 printed to 6 digits cannot start outside it
+# Stage 4c's last step (docs/studies/startup-profile.md 8.4, "The deep excursion"): the nb-ball design's first
+# excursion replaced by a fall to each of these bottom speeds and back at the acceleration limit
+# (deepen_first_excursion), each run on the polish's starts at mu 0.03; the best one that meets the family's bounds
+# is kept when it beats the nb-ball design on those starts. Helper h-mech's hand scan (512 LHS starts, seed 21,
+# six balls) had its best at 22.5 Hz (17 - 26 Hz tried): the old families' excursions stopped at 25 Hz.
+DEEP_BOTTOMS_HZ = (20.0, 21.5, 22.5, 23.5, 25.0)
 # The ball count of the last polish of 4c (equal total ball mass, equal_mass_balls); --shake-balls. Set from the
 # robust helper's re-optimisation of the two-shake design with N = 3..6 balls (6 balls: 12.83 against 14.12 with 2).
 SHAKE_BALLS = 6
@@ -166,13 +174,14 @@ class Study:
         with open(os.path.join(d, "result.json")) as f:
             return json.load(f)
 
-    def montecarlo(self, name, config_text, runs, seed, extra=()):
-        """abuopt montecarlo, random starts; kept when DIR/summary.json exists. Returns statistics."""
+    def montecarlo(self, name, config_text, runs, seed, extra=(), design="random"):
+        """abuopt montecarlo (random starts unless `design`); kept when DIR/summary.json exists. Returns statistics."""
         d = os.path.join(self.out, "validation", name)
         summary = os.path.join(d, "summary.json")
         cfg = os.path.join(d, "config.yaml")
         # Kept only when it was made from the same config (a changed design is validated again).
-        stamp = config_text + f"# runs {runs} seed {seed} {' '.join(extra)}\n"
+        stamp = config_text + f"# runs {runs} seed {seed} {' '.join(extra)}" + ("" if design == "random" else
+                                                                             f" design {design}") + "\n"
         stale = not os.path.exists(cfg) or read(cfg) not in (stamp, config_text)
         if stale or not os.path.exists(summary):
             if os.path.exists(summary):
@@ -182,7 +191,7 @@ class Study:
             with open(cfg, "w") as f:
                 f.write(stamp)
             start = time.time()
-            cmd = [self.a.abuopt, "montecarlo", cfg, "--design", "random", "--runs", str(runs), "--seed", str(seed),
+            cmd = [self.a.abuopt, "montecarlo", cfg, "--design", design, "--runs", str(runs), "--seed", str(seed),
                    "--threads", str(self.a.threads), "--out", d] + list(extra)
             r = subprocess.run(["nice", "-n", str(self.a.nice)] + cmd, capture_output=True, text=True)
             if r.returncode == 3 and os.path.exists(summary):
@@ -336,6 +345,23 @@ def insert_shake(segments, index, offset_s, depth_hz, f0=0.0, max_rate_hz_s=MAX_
     d = shake_duration(depth_hz, max_rate_hz_s)
     return (list(segments[:index]) + [(f, offset_s), (f - depth_hz, d), (f, d), (f, dt - offset_s)]
             + list(segments[index + 1:]))
+
+
+def deepen_first_excursion(segments, bottom_hz, f0=0.0, max_rate_hz_s=MAX_RATE_HZ_S):
+    """The profile [(end_frequency_hz, duration_s)] from f0 with its first excursion (the two segments after its
+    first dwell at f: away, then to f_r) replaced by a fall to bottom_hz and a rise back to f_r, each at the
+    acceleration limit (shake_duration: peak |f'| max_rate_hz_s / SHAKE_RATE_MARGIN). The rest is unchanged (delayed
+    by the change of the excursion's duration). Pure; ValueError when no dwell is followed by two segments or
+    bottom_hz is not in (0, min(f, f_r))."""
+    ds = dwells(segments, f0)
+    if not ds or ds[0] + 2 >= len(segments):
+        raise ValueError("the profile has no dwell followed by an excursion (two more segments)")
+    k = ds[0]
+    f, f_r = segments[k][0], segments[k + 2][0]
+    if not 0 < bottom_hz < min(f, f_r):
+        raise ValueError(f"excursion bottom {bottom_hz} Hz: must be in (0, {min(f, f_r)}) Hz")
+    return (list(segments[:k + 1]) + [(bottom_hz, shake_duration(f - bottom_hz, max_rate_hz_s)),
+                                      (f_r, shake_duration(f_r - bottom_hz, max_rate_hz_s))] + list(segments[k + 3:]))
 
 
 def design_x(segments, text):
@@ -564,7 +590,60 @@ def shake_chain(st, config, start, profile, budget, nb):
         out[name] = {"result": r, "formulation": 3, "T": b["metrics"]["startup_time_s"], "start": start,
                      "balls": nb if dwell is None else 2}
         prof, start = b["profile"], name
+    out[f"f3_mu03_shake2_deep_balls{nb}"] = deep_scan(st, set_section_value(config("f3_mu03_shake2"), "runs",
+                                                                             budget[0][1]), prof, start, nb)
     return out
+
+
+def section_number(text, key):
+    """The number of the first `key: <number>` line of a config text."""
+    m = re.search(r"^\s*" + re.escape(key) + r":\s*([-+\d.eE]+)", text, re.M)
+    if not m:
+        raise ValueError(f"key {key} not found")
+    return float(m.group(1))
+
+
+def deep_scan(st, family, profile, start, nb):
+    """Stage 4c's last step: `profile` (start's, made with nb balls) and the same with its first excursion deepened
+    to each of DEEP_BOTTOMS_HZ (deepen_first_excursion), run with nb balls at mu 0.03 on the family's starts (its
+    montecarlo design, runs and seed: the polish's starts); the best of them in the mean |I_r| that meets the family's
+    bounds on the startup time and the peak amplitude (the nb-ball design itself when none beats it). Returns a
+    design entry like the optimised ones ("result" with a best of objective, profile, feasible, metrics)."""
+    runs, seed = int(section_number(family, "runs")), int(section_number(family, "seed"))
+    mc_design = re.search(r"^\s*design:\s*(\w+)", family[re.search(r"^montecarlo:", family, re.M).start():],
+                          re.M).group(1)
+    t_max, amp_max = section_number(family, "max_startup_time_s"), section_number(family, "max_amplitude_mm")
+    f0 = profile.get("start_frequency_hz", 0.0)
+    cands = [(None, profile)]
+    for bottom in DEEP_BOTTOMS_HZ:
+        try:
+            segs = deepen_first_excursion(segments_of(profile), bottom, f0)
+        except ValueError as e:
+            st.log(f"[deep] {bottom} Hz: skipped ({e})")
+            continue
+        cands.append((bottom, {"start_frequency_hz": f0,
+                               "segments": [{"end_frequency_hz": f, "duration_s": d} for f, d in segs]}))
+    best, first = None, None
+    for bottom, prof in cands:
+        T = sum(g["duration_s"] for g in prof["segments"])
+        label = "as polished" if bottom is None else f"{bottom:g} Hz"
+        cfg = run_config(prof, f"stage 4c deep scan: {start}, first excursion {label}, {nb} balls",
+                         balls=equal_mass_balls(nb), contact=st.a.contact)
+        r = st.montecarlo(f"deep_balls{nb}_" + ("start" if bottom is None else f"{bottom:g}Hz"), cfg, runs, seed,
+                          ["--mu", "0.03"], design=mc_design)
+        feasible = T <= t_max + 1e-9 and r["amp_max_mm"] <= amp_max
+        st.log(f"[deep] first excursion {label}: mean |I_r| {r['ir']['mean']:.3f} at mu 0.03 ({runs} {mc_design} "
+               f"starts, seed {seed}, {nb} balls), T {T:.2f} s, peak amplitude {r['amp_max_mm']:.4f} mm"
+               f"{'' if feasible else ' (outside the bounds)'}")
+        first = first or (bottom, prof, r, T)
+        if feasible and (best is None or r["ir"]["mean"] < best[2]["ir"]["mean"]):
+            best = (bottom, prof, r, T)
+    bottom, prof, r, T = best or first  # none within the bounds: the design as polished
+    st.log(f"[deep] kept: {'the design as polished' if bottom is None else f'the first excursion to {bottom:g} Hz'} "
+           f"({r['ir']['mean']:.3f})")
+    return {"result": {"best": {"objective": r["ir"]["mean"], "feasible": True, "x": {}, "profile": prof,
+                                "metrics": {"startup_time_s": T, "max_amplitude_mm": r["amp_max_mm"]}}},
+            "formulation": 3, "T": T, "start": start, "balls": nb, "deep_bottom_hz": bottom}
 
 
 def main():
@@ -650,12 +729,13 @@ def main():
     st.evals_total = (len(FAMILIES) * (g_evals + p_evals) + p_evals + len(FRONT_T) * front_evals + 1 +
                       (f2_starts + f2p_starts_n) * f2_evals + 1 + robust_evals + 2 * len(counts) * p_evals + q_evals
                       + sum(g + 2 * p for g, _, p, _ in f3_budget.values()) + f2q_budget[0] + 4 * f2q_budget[2] + 2)
-    n_designs += 2 * len(f3_budget) + len(shake_budget)
+    n_designs += 2 * len(f3_budget) + len(shake_budget) + 1  # 4c's three designs and its deep step
     st.evals_total += sum(e for e, _ in shake_budget)
     st.runs_total = ((n_designs + 1) * val_runs * 4 + 7 * (val_runs * 2 + (switch_runs * 2 if contact == "none" else 0))
                      + (len(DRIVE_MADE) + 1) * val_runs
                      + len(counts) * 3 * val_runs + (2 * len(f3_budget) + 1 + len(shake_budget)) * val_runs
-                     + 6 * val_runs)  # the shake designs' mu 0.03 on seed 9002; 3 with N balls on 2 seeds
+                     + 8 * val_runs  # the shake designs' mu 0.03 on seed 9002; 4 with N balls on 2 seeds
+                     + (len(DEEP_BOTTOMS_HZ) + 1) * shake_budget[0][1])  # 4c's deep scan
     st.log(f"startup study, ball contact {contact}: {n_designs} designs, about {st.evals_total} evaluations and "
            f"{st.runs_total} validation runs; output {st.out}")
 
@@ -1004,25 +1084,26 @@ def shake_validation(st, designs, table, profiles, nb):
                          "x_better_2balls": ref / d["mean"],  # in sample: only with the balls it was made with
                          "in_sample": designs[n]["result"]["best"]["objective"] if designs[n].get("balls", 2) == 2
                          else None})
-    made = f"f3_mu03_shake2_balls{nb}"
+    made, deep = f"f3_mu03_shake2_balls{nb}", f"f3_mu03_shake2_deep_balls{nb}"
     bl = equal_mass_balls(nb)
     cfg = {k: run_config(profiles[k], f"{k} with {nb} balls of equal total mass, ball contact {st.a.contact}",
-                         balls=bl, contact=st.a.contact) for k in ("report_2003", "f3_mu03_shake2", made)}
-    with open(os.path.join(st.out, "best", made + ".yaml"), "w") as f:  # made with nb balls: runs with them
-        f.write(cfg[made])
+                         balls=bl, contact=st.a.contact) for k in ("report_2003", "f3_mu03_shake2", made, deep)}
+    for k in (made, deep):
+        with open(os.path.join(st.out, "best", k + ".yaml"), "w") as f:  # made with nb balls: runs with them
+            f.write(cfg[k])
     for seed, sfx, sub in ((VALIDATION_SEED, "", "mu0.03"), (SECOND_SEED, "_s9002", "mu0.03_s9002")):
         ref = st.montecarlo(f"shake_balls{nb}_report_2003_mu0.03{sfx}", cfg["report_2003"], st.a.val_runs, seed,
                             ["--mu", "0.03"])
         two = table["report_2003"][sub]["ir"]["mean"]
         # the two-shake design (made with 2 balls) with nb balls too: what the polish with nb balls adds
-        for n in ("f3_mu03_shake2", made):
+        for n in ("f3_mu03_shake2", made, deep):
             d = st.montecarlo(f"shake_balls{nb}_{n}_mu0.03{sfx}", cfg[n], st.a.val_runs, seed, ["--mu", "0.03"])
             p = paired_of(os.path.join(val_dir, f"shake_balls{nb}_{n}_mu0.03{sfx}"),
                           os.path.join(val_dir, f"shake_balls{nb}_report_2003_mu0.03{sfx}"))
             rows.append({"design": n, "balls": nb, "seed": seed, "T": table[n]["T"], "mean": d["ir"]["mean"],
                          "lo": d["ir"]["lo"], "hi": d["ir"]["hi"], "ref2003": ref["ir"]["mean"], "paired": p,
                          "x_better": ref["ir"]["mean"] / d["ir"]["mean"], "x_better_2balls": two / d["ir"]["mean"],
-                         "in_sample": designs[n]["result"]["best"]["objective"] if n == made else None})
+                         "in_sample": designs[n]["result"]["best"]["objective"] if n in (made, deep) else None})
     st.log(f"[shakes] at mu 0.03, {st.a.val_runs} fresh starts, the 2003 profile on the same starts:")
     for r in rows:
         st.log(f"[shakes] {r['design']} ({r['balls']} balls, seed {r['seed']}): {r['mean']:.2f} [{r['lo']:.2f}, "
@@ -1245,7 +1326,7 @@ def make_plots(st, table, designs, best19):
         chain = ["report_2003", designs[shakes[0]]["start"]] + shakes
         scripts["profiles_shake.png"] = (
             f"set title 'stage 4c: shakes at mu 0.03 (ball contact {st.a.contact}), from {chain[1]}'\n"
-            "set xlabel 'time [s]'; set ylabel 'frequency [Hz]'; set xrange [0:20]; set yrange [20:32]; "
+            "set xlabel 'time [s]'; set ylabel 'frequency [Hz]'; set xrange [0:20]; set yrange [18:32]; "
             "set key bottom right\nplot " + ", ".join(
                 f"'profiles.dat' index {names.index(n)} with lines lw {3 if n == 'report_2003' else 1.5} title '{n}'"
                 for n in chain))

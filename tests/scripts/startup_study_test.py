@@ -145,6 +145,32 @@ def shakes(abuopt, tmp, cdir):
             check(False, f"insert_shake refuses {what}")
         except ValueError:
             check(True, f"insert_shake refuses {what}")
+    # deepen_first_excursion: the first excursion after the first dwell replaced by a fall to the bottom and a rise
+    # back to where it returned, each at the acceleration limit; before it the profile is unchanged, after it delayed.
+    deep = study.deepen_first_excursion(new, 22.5)
+    k = study.dwells(new)[0]
+    t_dwell_end = sum(dt for _, dt in new[:k + 1])
+    d_down, d_up = study.shake_duration(28.9129 - 22.5), study.shake_duration(28.9129 - 22.5)
+    shift = d_down + d_up - 2 * d
+    fine = [t_dwell_end + (d_down + d_up) * j / 4000 for j in range(4001)]
+    low = min(study.frequency_at(deep, t) for t in fine)
+    rate = max(abs(study.frequency_at(deep, b) - study.frequency_at(deep, a)) / (b - a) for a, b in zip(fine, fine[1:]))
+    before = max(abs(study.frequency_at(deep, t) - study.frequency_at(new, t)) for t in grid if t <= t_dwell_end)
+    after = max(abs(study.frequency_at(deep, t + shift) - study.frequency_at(new, t))
+                for t in grid if t_dwell_end + 2 * d <= t <= total + 2 * d)
+    check(len(deep) == len(new) and deep[k + 1][0] == 22.5 and deep[k + 2][0] == new[k + 2][0]
+          and abs(low - 22.5) < 1e-9 and study.MAX_RATE_HZ_S / study.SHAKE_RATE_MARGIN * 0.9999 < rate
+          <= study.MAX_RATE_HZ_S and before < 1e-12 and after < 1e-9
+          and abs(d_down - 2 * 6.4129 / study.MAX_RATE_HZ_S * study.SHAKE_RATE_MARGIN) < 1e-12,
+          f"deepen_first_excursion: down to {low:.6f} Hz at peak f' {rate:.4f} Hz/s, unchanged before ({before:.1e}), "
+          f"delayed by {shift:.5f} s after ({after:.1e})")
+    for args, what in (((new, 28.9129), "bottom = the dwell"), ((new, 0.0), "bottom 0"),
+                       ((segs[:1] + [(28.0, 1.0)], 20.0), "no dwell")):
+        try:
+            study.deepen_first_excursion(*args)
+            check(False, f"deepen_first_excursion refuses {what}")
+        except ValueError:
+            check(True, f"deepen_first_excursion refuses {what}")
     # The two-shake profile in the families' bounds (no clipping), and abuopt reads x back as that profile.
     two = study.insert_shake(new, 5, 1.5, 3.0)
     for name, prof in (("f3_mu03_shake1", new), ("f3_mu03_shake2", two)):
@@ -179,9 +205,10 @@ def end_to_end(abuopt, tmp):
     f3_aimed = ({f"{n}_from_{start}" for n in ("f3_mu03", "f3_robust_k6") for start in ("global", "k6")}
                 | {"f3_mu03_k4_from_global", "f3_mu03_k4_from_k4", "f3_mu03_release_from_global",
                    "f3_mu03_release_from_scan"}
-                | {"f3_mu03_shake1", "f3_mu03_shake2", "f3_mu03_shake2_balls3"})
+                | {"f3_mu03_shake1", "f3_mu03_shake2", "f3_mu03_shake2_balls3", "f3_mu03_shake2_deep_balls3"})
     # 16 + the eight aimed formulation-3 designs + formulation 2 with the PI motor and with PI + 1 Hz + the 3 shakes
-    n_expected = 29
+    # + the deep excursion
+    n_expected = 30
     check(len(s["table"]) == n_expected and f3_aimed <= set(s["table"])
           and all(row["ideal"]["ok"] == 8 and row["s9002"]["ok"] == 8 for row in s["table"].values()),
           f"{len(s['table'])} designs validated on seeds 9001 and 9002, every run ok")
@@ -220,12 +247,27 @@ def end_to_end(abuopt, tmp):
               f"{n}: validated under its drive ({key}) on seeds 9001 and 9002, paired against 2003, both definitions")
     sh = s["shake"]
     rows = {(r["design"], r["balls"], r["seed"]) for r in sh["rows"]}
-    chain = [sh["start"], "f3_mu03_shake1", "f3_mu03_shake2", "f3_mu03_shake2_balls3"]
+    chain = [sh["start"], "f3_mu03_shake1", "f3_mu03_shake2", "f3_mu03_shake2_balls3", "f3_mu03_shake2_deep_balls3"]
     check(sh["balls"] == 3 and sh["start"] in ("f3_mu03_k4_from_global", "f3_mu03_k4_from_k4") and
           rows == {(n, 2, seed) for n in chain for seed in (9001, 9002)}
-          | {(n, 3, seed) for n in ("f3_mu03_shake2", "f3_mu03_shake2_balls3") for seed in (9001, 9002)}
+          | {(n, 3, seed) for n in ("f3_mu03_shake2", "f3_mu03_shake2_balls3", "f3_mu03_shake2_deep_balls3")
+             for seed in (9001, 9002)}
           and all(r["x_better"] > 0 and r["paired"]["n"] == 8 for r in sh["rows"]),
-          f"stage 4c: its start and three designs at mu 0.03 on both seeds, the last also with 3 balls ({len(rows)} rows)")
+          f"stage 4c: its start and four designs at mu 0.03 on both seeds, the last two also with 3 balls "
+          f"({len(rows)} rows)")
+    # the deep scan: the polished design and one deepened profile per bottom speed, each on the polish's 10 LHS starts
+    # with 3 balls at mu 0.03; the kept one (in best/, with 3 balls) is one of them
+    scan = sorted(x for x in os.listdir(os.path.join(out, "validation")) if x.startswith("deep_balls3_"))
+    want = sorted(["deep_balls3_start"] + [f"deep_balls3_{b:g}Hz" for b in study.DEEP_BOTTOMS_HZ])
+    scan_cfg = study.read(os.path.join(out, "validation", "deep_balls3_22.5Hz", "config.yaml")) if scan == want else ""
+    kept = study.read(os.path.join(out, "best", "f3_mu03_shake2_deep_balls3.yaml"))
+    check(scan == want and "# runs 10 seed 21 --mu 0.03 design lhs" in scan_cfg
+          and len(re.findall(r"^    - \{mass_kg", scan_cfg, re.M)) == 3
+          and len(re.findall(r"^    - \{mass_kg", kept, re.M)) == 3
+          and re.search(r"end_frequency_hz: 22\.5,", scan_cfg)
+          and any(study.profile_yaml(s["table"]["f3_mu03_shake2_deep_balls3"]["profile"]) in
+                  study.read(os.path.join(out, "validation", x, "config.yaml")) for x in scan),
+          f"stage 4c's deep scan: {scan}; the kept design is one of them, with 3 balls")
     s1, s2 = (study.read(os.path.join(out, n, "config.yaml")) for n in ("f3_mu03_shake1", "f3_mu03_shake2"))
     s3, b3 = (study.read(p) for p in (os.path.join(out, "f3_mu03_shake2_balls3", "config.yaml"),
                                       os.path.join(out, "best", "f3_mu03_shake2_balls3.yaml")))
