@@ -433,7 +433,8 @@ def analyse_runs(rows, segments, mu, entry=None, abu=None, split="speed", edge=N
                      "depth_median": quantile([x["depth"] for x in grp], 0.5),
                      "depth_interval": mean_interval([x["depth"] for x in grp]),
                      "median_interval": median_interval([x["depth"] for x in grp])}
-    out["depth_mean"] = (len(early) * out["early"]["depth_mean"] + len(late) * out["late"]["depth_mean"]) / n
+    out["depth_mean"] = ((len(early) * out["early"]["depth_mean"] if early else 0.0)
+                         + (len(late) * out["late"]["depth_mean"] if late else 0.0)) / n
     out["depth_interval"] = mean_interval([x["depth"] for x in early + late])
     out["records"] = {"early": early, "late": late}
     if entry is not None:
