@@ -12,6 +12,12 @@ Kolmogorov-Smirnov distance of a disc-uniform sample from t^2 and from t (1/4); 
 |U| <= r_lock. And one Monte Carlo of the robust design through abuopt (256 starts): the runs locked before the
 band are as many and as deep as uniform starts in the lock set, within binomial and sampling tolerances; no
 close pair ends below the pair floor of its separation; the CDF plot's data has one line per run.
+N balls (six of the two balls' total mass): U = 0 at a hand-made balancing configuration (three pairs at pi -+ theta_k,
+sum cos theta_k = m_I e / (2 m L)), where the gauge is 0; six touching balls have the cluster floor |m_I e - m L
+sin(3 s_c) / sin(s_c / 2)| = 9.96e-7 kg m; two balls through the N-ball code give the two-ball numbers (M, r_lock,
+gauge; the cluster floor is the pair floor of a close pair, 0 apart); the lemma for six balls; a hand-made six-ball
+runs.csv through the command line (early / late shares, depths, the passage split); and abuopt's |I_r| of six balls
+is |U| of their final angles.
 """
 import cmath
 import math
@@ -136,10 +142,115 @@ def monte_carlo(abuopt):
         check(os.path.exists(os.path.join(tmp, "stop_distribution.gp")), "the gnuplot script is written")
 
 
+def n_balls():
+    """The N-ball extension, checked by hand (docs: stop_distribution.py's docstring, the cluster floor)."""
+    six = sd.Abu.equal_mass(6)
+    m, d = six.masses[0], six.diameters[0]
+    check(abs(six.M - sd.M) < 1e-15 and abs(sd.r_lock(0.03, six) - sd.r_lock(0.03)) < 1e-20
+          and abs(m - 4.6667e-5) < 1e-9 and abs(d - 2.0801e-3) < 1e-7,
+          f"six balls of the two balls' total mass: m {m:.4e} kg, d {d * 1e3:.4f} mm, the same M and r_lock")
+    # A balancing configuration: pairs at pi -+ theta_k with sum cos theta_k = m_I e / (2 m L) = 1.9304.
+    c = sd.MI * sd.E / (2 * m * sd.L)
+    cos3 = [0.9, 0.65, c - 1.55]
+    b = []
+    for ck in cos3:
+        t = math.acos(ck)
+        b += [math.pi - t, math.pi + t]
+    check(abs(c - 1.9304) < 1e-4 and abs(sd.imbalance(b, six)) < 1e-12 * sd.MI * sd.E,
+          f"U = 0 at pairs pi -+ acos({cos3[0]}, {cos3[1]}, {cos3[2]:.4f}) (sum of cosines {c:.4f})")
+    check(sd.gauge(28.9, b, 0.03, six) < 1e-9 and sd.lock_gauge(b, 0.03, abu=six) < 1e-9
+          and sd.cluster_floor(b, six) == 0.0 and len(sd.clusters(b, six)) == 6,
+          "there the gauge and the lock gauge are 0 (<= 1: locked), the six balls are apart, the cluster floor 0")
+    s = sd.contact_separation(d, d)
+    chain = [math.pi + (k - 2.5) * s for k in range(6)]  # six touching balls centred opposite the imbalance
+    closed = abs(sd.MI * sd.E - m * sd.L * math.sin(3 * s) / math.sin(s / 2))
+    check(abs(s - 0.18112) < 5e-5 and abs(closed - 9.96e-7) < 0.005e-7 and len(sd.clusters(chain, six)) == 1
+          and abs(abs(sd.imbalance(chain, six)) - closed) < 1e-15 and abs(sd.cluster_floor(chain, six) - closed) < 1e-15
+          and abs(sd.one_cluster_floor(six) - closed) < 1e-15,
+          f"six touching balls (s_c {s:.5f} rad): one cluster, |U| = its floor = {closed / 1e-7:.3f}e-7 (closed form)")
+    five = chain[:5] + [chain[5] + 0.5]  # one ball off the chain: the floor max(0, 2 max a - sum a) = 0
+    check(len(sd.clusters(five, six)) == 2 and sd.cluster_floor(five, six) == 0.0,
+          "five touching and one apart: two clusters, no floor (2 max a < sum a)")
+    two = sd.Abu.equal_mass(2)
+    rng = random.Random(11)
+    worst_g, worst_floor, n_close, n_in, least = 0.0, 0.0, 0, 0, math.inf
+    for _ in range(3000):
+        bb = (rng.uniform(0, 2 * math.pi), rng.uniform(0, 2 * math.pi))
+        if rng.random() < 0.3:
+            bb = (bb[0], bb[0] + rng.choice((1, -1)) * (sd.CONTACT_SEPARATION + rng.uniform(-0.03, 0.04)))
+        worst_g = max(worst_g, abs(sd.gauge(29.0, bb, 0.03, two) - sd.gauge(29.0, bb, 0.03)))
+        pair = abs(sd.MI * sd.E - 2 * sd.M_BALL * sd.L * math.cos(sd.separation(bb) / 2)) if sd.is_touching(bb) else 0.0
+        n_close += sd.is_touching(bb)
+        worst_floor = max(worst_floor, abs(sd.cluster_floor(bb) - pair))
+        b6 = [rng.uniform(0, 2 * math.pi) for _ in range(6)]
+        f, mu = rng.uniform(20, 40), rng.choice((0.02, 0.03, 0.04))
+        g6 = sd.gauge(f, b6, mu, six)
+        if g6 <= 1:
+            n_in += 1
+            least = min(least, abs(sd.imbalance(b6, six)) / (g6 * sd.r_in(f, mu, six)) if g6 > 0 else math.inf)
+    check(worst_g < 1e-12 and worst_floor < 1e-18 and n_close > 500,
+          f"two balls through the N-ball code: the same gauge, the cluster floor = the pair floor ({n_close} close pairs) "
+          "or 0")
+    check(n_in > 300 and least >= 1 - 1e-12, f"six balls: |U| >= g(f) r_in(f) in all {n_in} random configurations in "
+          f"the set (least ratio {least:.4f})")
+    # A hand-made runs.csv: two runs settled in the first ramp (0 -> 25 Hz in 1 s), one at the balancing configuration
+    # (depth 0), one touching chain (depth 9.96e-7 / r_lock); two in the last ramp (after 11 s), the chain and a
+    # balancing configuration; one not settled (left out).
+    rl = sd.r_lock(0.03, six)
+    runs = [(0.8, b, 1), (0.9, chain, 1), (12.0, chain, 1), (13.0, b, 1), (38.0, chain, 0)]
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "runs.csv")
+        with open(path, "w") as fh:
+            fh.write("index," + ",".join(f"beta0_{k}" for k in range(1, 7)) + ",mu,imbalance_mass_kg,imbalance_angle_rad,"
+                     + ",".join(f"beta_final_{k}" for k in range(1, 7))
+                     + ",ir_magnitude_kgm,ir_x_kgm,settled,settling_time_s,max_amplitude_mm,events,rhs_evaluations,status\n")
+            for i, (t, bb, settled) in enumerate(runs):
+                fh.write(f"{i}," + ",".join("0" for _ in range(6)) + ",0.03,,0," + ",".join(f"{x:.17g}" for x in bb)
+                         + f",{abs(sd.imbalance(bb, six)):.17g},0,{settled},{t},0.1,1,1,ok\n")
+        script = os.path.join(ROOT, "scripts", "stop_distribution.py")
+        prof = "25:1,29.5:10,100:8"
+        r = subprocess.run([sys.executable, script, "runs", path, "--profile", prof, "--mu", "0.03", "--balls", "6",
+                            "--ci"], capture_output=True, text=True)
+        depth = closed / rl
+        check(r.returncode == 0 and "4 settled runs" in r.stdout and f"mean depth {depth / 2:.3f} r_lock" in r.stdout
+              and f"early  50.0 %: mean depth {depth / 2:.3f}" in r.stdout and f"late   50.0 %: mean depth {depth / 2:.3f}"
+              in r.stdout and "held by a cluster 50.0 %" in r.stdout,
+              f"CLI, six balls: 4 settled runs, early 50 % and late 50 % both at {depth / 2:.3f} r_lock (half at 0, half "
+              f"at the chain's {depth:.3f}), half of each held by a cluster")
+        r2 = subprocess.run([sys.executable, script, "runs", path, "--profile", prof, "--mu", "0.03"],
+                            capture_output=True, text=True)
+        check(r2.returncode != 0 and "give --config or --balls" in r2.stderr, "six-ball runs.csv without the balls: refused")
+        rows = sd.read_runs(path)
+        out = sd.analyse_runs(rows, [(25, 1), (29.5, 10), (100, 8)], 0.03, abu=six, split="passage", edge=25.0)
+        check(out["early"]["count"] == 2 and abs(out["t_edge"] - 1.0) < 1e-4 and out["late"]["count"] == 2,
+              f"passage split at 25 Hz: the first passage at t = {out['t_edge']:.6f} s (the end of the first ramp), two early")
+
+
+def six_ball_runs(abuopt):
+    """abuopt's |I_r| of six balls is |U| of its final angles (64 starts of the six-ball design at mu 0.03)."""
+    cfg = os.path.join(ROOT, "configs", "studies", "best", "contact_best_mu03_shake_6balls.yaml")
+    six = sd.Abu.from_config(cfg)
+    with tempfile.TemporaryDirectory() as tmp:
+        r = subprocess.run([abuopt, "montecarlo", cfg, "--mu", "0.03", "--runs", "64", "--seed", "9001", "--threads", "1",
+                            "--out", tmp], capture_output=True, text=True)
+        check(r.returncode == 0, "abuopt montecarlo of contact_best_mu03_shake_6balls (64 starts) runs")
+        if r.returncode != 0:
+            return
+        rows = sd.read_runs(os.path.join(tmp, "runs.csv"))
+        n = sd.ball_count(os.path.join(tmp, "runs.csv"))
+    worst = max(abs(abs(sd.imbalance([float(x[f"beta_final_{k}"]) for k in range(1, 7)], six))
+                    - float(x["ir_magnitude_kgm"])) for x in rows)
+    check(n == 6 and len(rows) == 64 and worst < 1e-6 * sd.MI * sd.E,
+          f"six balls: |U| of the final angles = abuopt's |I_r| in all {len(rows)} runs (largest difference "
+          f"{worst:.2e} kg m)")
+
+
 def main(abuopt):
     closed_forms()
     lemma()
     lock_set()
+    n_balls()
+    six_ball_runs(abuopt)
     monte_carlo(abuopt)
     print(f"{len(failures)} failure(s)")
     return 1 if failures else 0
