@@ -33,6 +33,20 @@ struct Violation {
   std::size_t pair = 0;   // the cut pair that closes (Closing)
 };
 
+// Two touching balls (rear speed va, front vb) move as one if their speeds agree: an approach
+// slower than 1e-9 (1 + |va|) is a plastic touch (an impact below v_stop would join them too), but
+// a pair that separates, however slowly, is not in contact: it is linked only if the speeds agree
+// to 1e-9 of their size (rounding). With the absolute 1e-9 for separating pairs too, a ball that
+// had just stopped behind a chain slipping away from it at |v| < 1e-9 was joined to the chain and
+// given the chain's mean speed, stopped again, was joined again: a chain losing a fixed share of
+// its speed per event, events accumulating at a finite time (Zeno), the chatter limit
+// (docs/model.md 11.10).
+bool touching_speeds(double va, double vb) {
+  const double closing = va - vb;  // > 0: the rear ball gains on the front one
+  if (closing >= 0) return closing <= 1e-9 * (1 + std::fabs(va));
+  return -closing <= 1e-9 * std::max(std::fabs(va), std::fabs(vb));
+}
+
 class ModeChoice {
  public:
   ModeChoice(RunState& rs, double W, double Wp, std::vector<double>& y, const std::vector<char>& forced, double band)
@@ -46,7 +60,7 @@ class ModeChoice {
     for (std::size_t k = 0; k < K; ++k) {
       const std::size_t a = cs_.geo.order[k], b = cs_.geo.order[(k + 1) % n];
       const double va = y[lay_.beta_dot(a)], vb = y[lay_.beta_dot(b)];
-      link_[k] = cs_.closed[k] || (cs_.geo.gap(beta, k) <= kGapTol && std::fabs(vb - va) <= 1e-9 * (1 + std::fabs(va)));
+      link_[k] = cs_.closed[k] || (cs_.geo.gap(beta, k) <= kGapTol && touching_speeds(va, vb));
     }
     if (std::all_of(link_.begin(), link_.end(), [](char c) { return c != 0; })) link_[K - 1] = 0;
     std::size_t open = 0;

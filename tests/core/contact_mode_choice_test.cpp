@@ -9,6 +9,7 @@
 #include <random>
 
 #include "abuopt/core/ball_contact.hpp"
+#include "sim_contact.hpp"
 #include "sim_run_state.hpp"
 
 using namespace abuopt;
@@ -225,5 +226,52 @@ TEST(ContactModeChoice, PivotingIsConsistentWheneverTheEnumerationIsAndMostlyAgr
     EXPECT_GE(consistent_e, states * 9 / 10);  // the random states are mostly solvable
     EXPECT_GE(plain_same, plain * 99 / 100);
     EXPECT_LE(max_pivots, static_cast<int>(4 * n) + 8);
+  }
+}
+
+// Two touching balls at speeds far below the old absolute tolerance 1e-9 (docs/model.md 11.10):
+// a pair that separates (the rear ball slips back, away from the front ball at rest) is not in
+// contact: the choice leaves both speeds as they are and the pair open. A pair that approaches as
+// slowly is a plastic touch: both at the mean speed (equal masses), momentum kept.
+TEST(ContactModeChoice, ASlowlySeparatingPairIsNotJoinedAnApproachingOneIs) {
+  EventState s;
+  s.p.ball_contact = BallContact::Hard;
+  s.p.friction_mu = 0.02;
+  s.p.balls.assign(2, Ball{1.4e-4, 3e-3});
+  const StateLayout lay{2};
+  const NondimParameters nd = NondimParameters::from(s.p);
+  s.y.assign(lay.size(), 0.0);
+  s.y[lay.beta(0)] = 1.0;
+  s.y[lay.beta(1)] = 1.0 + contact_spacing(s.p, 0, 1);  // touching: gap 0 (to rounding)
+  s.W = 2 * M_PI * 28.9 / nd.omega_n;
+  s.forced.assign(2, 0);
+  s.touching = {1, 0};
+  for (const double v : {1e-11, 1e-14}) {
+    // separating: rear (ball 0) slips back at -v, front (ball 1) at rest
+    {
+      EventState a = s;
+      a.y[lay.beta_dot(0)] = -v;
+      auto rs = make_run_state(a);
+      rs->cs.closed.assign(2, 0);  // two clusters: the pair was apart (or cut) before this event
+      detail::build_clusters(*rs);
+      std::vector<double> y = a.y;
+      detail::choose_contact_modes(*rs, a.W, a.Wp, y, a.forced);
+      EXPECT_EQ(y[lay.beta_dot(0)], -v) << v;
+      EXPECT_EQ(y[lay.beta_dot(1)], 0.0) << v;
+      EXPECT_EQ(rs->cs.closed[0] + rs->cs.closed[1], 0) << v;
+      EXPECT_EQ(rs->modes[0], BallMode::SlipBackward) << v;
+    }
+    // approaching: front (ball 1) slips back at -v onto the rear ball at rest
+    {
+      EventState a = s;
+      a.y[lay.beta_dot(1)] = -v;
+      auto rs = make_run_state(a);
+      rs->cs.closed.assign(2, 0);  // two clusters: the pair was apart (or cut) before this event
+      detail::build_clusters(*rs);
+      std::vector<double> y = a.y;
+      detail::choose_contact_modes(*rs, a.W, a.Wp, y, a.forced);
+      EXPECT_NEAR(y[lay.beta_dot(0)], -0.5 * v, 1e-16 * v) << v;
+      EXPECT_EQ(y[lay.beta_dot(0)], y[lay.beta_dot(1)]) << v;
+    }
   }
 }

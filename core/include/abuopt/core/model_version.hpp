@@ -9,7 +9,9 @@ namespace abuopt {
 // Hard ball-ball contact (abu.ball_contact: hard). 1: modes chosen by enumeration, a forced block
 // released forward whatever margin crossed; 2: pivoting choice, a forced block released only in the
 // direction whose margin crossed (docs/model.md 11.8); 3: gap events located by Newton on the
-// Runge-Kutta solution to a derived tolerance instead of 2 ulp (docs/model.md 11.9).
-inline constexpr int kContactModelVersion = 3;
+// Runge-Kutta solution to a derived tolerance instead of 2 ulp (docs/model.md 11.9); 4: a touching
+// pair that separates is joined at an event only if its speeds agree to 1e-9 relative, not 1e-9
+// absolute (the Zeno chatter of slow chains, docs/model.md 11.10).
+inline constexpr int kContactModelVersion = 4;
 
 }  // namespace abuopt
