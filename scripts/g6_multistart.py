@@ -144,7 +144,7 @@ def montecarlo_config(x, balls=6, runs=256, seed=21, design="lhs"):
             f"montecarlo:\n  design: {design}\n  runs: {runs}\n  seed: {seed}\n  threads: 1\n")
 
 
-def optimize_config(x, balls=6, runs=256, budget=40, step=0.1, comment=""):
+def optimize_config(x, balls=6, runs=256, budget=40, step=0.1, comment="", t_max=19):
     v = dict(zip(NAMES, x))
 
     def var(n):
@@ -172,7 +172,7 @@ def optimize_config(x, balls=6, runs=256, budget=40, step=0.1, comment=""):
             "design:\n  segments:\n" + "\n".join(seg) + "\n"
             "objective:\n  kind: mean                   # mean |I_r| [1e-7 kg m] at mu = 0.03\n"
             "  definition: magnitude\n"
-            "constraints:\n  max_startup_time_s: 19\n  max_pct_mi: 100\n"
+            f"constraints:\n  max_startup_time_s: {t_max:g}\n  max_pct_mi: 100\n"
             "  max_amplitude_mm: 0.551      # the 2003 profile's peak amplitude at mu = 0.03\n"
             "  max_angular_acceleration_rad_s2: 314.16   # the 2003 profile's peak (first segment, 2 pi 50 Hz/s)\n"
             "validation:\n  enabled: false               # validated outside on 1024 fresh starts, seeds 9001 - 9003\n"
@@ -274,9 +274,19 @@ def cmd_local(a):
               f" x {json.dumps(b['x'])}", flush=True)
 
 
+OPT_NAMES = ["f1", "dt1", "f2", "dt2", "dt3", "dt4", "f5", "dt5", "dt6", "dt7", "f8", "dt8", "dt9", "dt10",
+             "f11", "dt11", "dt12", "dt13", "dt14"]  # abuopt optimize's names of NAMES, in the same order
+
+
+def x_of_result(path):
+    """The best x of an abuopt optimize result.json, in NAMES order."""
+    b = json.load(open(path))["best"]["x"]
+    return [b[n] for n in OPT_NAMES]
+
+
 def cmd_config(a):
-    x = [float(t) for t in a.x.split(",")]
-    sys.stdout.write(optimize_config(x, balls=a.balls, runs=a.runs, budget=a.budget, step=a.step))
+    x = x_of_result(a.x) if a.x.endswith(".json") else [float(t) for t in a.x.split(",")]
+    sys.stdout.write(optimize_config(x, balls=a.balls, runs=a.runs, budget=a.budget, step=a.step, t_max=a.t_max))
 
 
 def main():
@@ -301,11 +311,12 @@ def main():
     s.add_argument("--step", type=float, default=0.1)
     s.add_argument("--balls", type=int, default=6)
     s = sub.add_parser("config")
-    s.add_argument("--x", required=True)
+    s.add_argument("--x", required=True, help="comma-separated values in NAMES order, or a result.json")
     s.add_argument("--runs", type=int, default=256)
     s.add_argument("--budget", type=int, default=40)
     s.add_argument("--step", type=float, default=0.1)
     s.add_argument("--balls", type=int, default=6)
+    s.add_argument("--t-max", type=float, default=19, help="max_startup_time_s (the side result: 25)")
     a = p.parse_args()
     {"sample": cmd_sample, "screen": cmd_screen, "local": cmd_local, "config": cmd_config}[a.cmd](a)
 
