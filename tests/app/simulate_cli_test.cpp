@@ -96,7 +96,7 @@ TEST(SimulateCli, HelpExplainsTheCommand) {
 // The study's ready-to-run designs carry a montecarlo section (for `abuopt montecarlo`); simulate
 // checks it and runs the profile; a bad key in it is still an error naming the key.
 TEST(SimulateCli, RunsConfigsWithAMontecarloSection) {
-  const Result r = run("simulate " + kConfigs + "studies/best/best_19s.yaml --beta0 0.5,3.0 --json");
+  const Result r = run("simulate " + kConfigs + "studies/best/best_19s_nocontact.yaml --beta0 0.5,3.0 --json");
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(nlohmann::json::parse(r.output)["status"], "ok");
   const std::string bad = write_config("simulate_bad_mc.yaml", "montecarlo: {runz: 3}\n");

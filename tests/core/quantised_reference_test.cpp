@@ -15,7 +15,7 @@ namespace {
 
 constexpr double kTwoPi = 2.0 * M_PI;
 
-// Configs/studies/best/best_19s.yaml's profile (rounded as written there).
+// configs/studies/best/best_19s_nocontact.yaml's profile (rounded as written there).
 StartupProfile best_19s() {
   return StartupProfile({{27.0045, 1.95963}, {28.9248, 3.65881}, {28.9248, 4.64546}, {100, 8.50797}}, 0.0);
 }
