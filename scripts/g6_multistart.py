@@ -285,7 +285,15 @@ def x_of_result(path):
 
 
 def cmd_config(a):
-    x = x_of_result(a.x) if a.x.endswith(".json") else [float(t) for t in a.x.split(",")]
+    if a.x.endswith(".json"):
+        x = x_of_result(a.x)
+    else:
+        try:
+            x = [float(t) for t in a.x.split(",")]
+        except ValueError as e:
+            sys.exit(f"g6_multistart.py config: --x: {e}")
+    if len(x) != len(NAMES):  # zip() in segments()/optimize_config() would silently drop extra values
+        sys.exit(f"g6_multistart.py config: --x has {len(x)} values, the family has {len(NAMES)} ({','.join(NAMES)})")
     sys.stdout.write(optimize_config(x, balls=a.balls, runs=a.runs, budget=a.budget, step=a.step, t_max=a.t_max))
 
 
