@@ -14,7 +14,9 @@ factor. segments() of a hand-made point against hand-written segments, T and the
 `config --x` output of the incumbent and three LHS points is accepted by `abuopt optimize --max-evaluations 1
 --threads 1` (4 starts), abuopt's evaluated profile is the point's (1e-5 relative), its peak angular acceleration
 metric is 2 pi x peak_fdot (1e-6 relative) and <= 314.16, its startup time is T <= 19 s; `config --x
-result.json` gives back that x. Bad --x (18 or 20 values, a non-number) exits non-zero naming the problem.
+result.json` gives back that x. The study is reproduced (its points 73, 97, 99 of sample --n 127 --seed 5;
+config --x of the incumbent = configs/studies/mu03/f3_mu03_g6_local.yaml below its header). Bad --x (18 or 20 values, a
+non-number) exits non-zero naming the problem.
 """
 import json
 import math
@@ -161,6 +163,30 @@ def profile_of_point():
           f"profile_yaml(): 14 segment lines ({lines[1].strip()})")
 
 
+def reproduces_study():
+    """The study's global phase (configs/studies/mu03/f3_mu03_g6_local.yaml header: sample --n 127 --seed 5) is
+    reproduced: its points 73, 97 (the start of contact_best_mu03_g6) and 99 as the lock6 run wrote them (6 digits),
+    and `config --x` of the incumbent with --runs 256 --budget 50 is that shipped config below its header."""
+    pts = [g6.incumbent()] + g6.sample(127, 5)
+    study = {73: [25.28469, 2.288961, 20.93848, 0.947359, 0.325646, 0.703232, 23.346849, 0.227385, 0.601044,
+                  1.351823, 22.359816, 0.562475, 0.590376, 3.030381, 33.037105, 0.961864, 0.5319, 1.563664, 5.16434],
+             97: [17.857137, 1.522974, 25.102558, 0.538856, 0.225384, 3.259175, 22.190169, 0.677177, 0.478646,
+                  1.396052, 27.730327, 0.431484, 0.835069, 0.866226, 23.828077, 0.438372, 0.818898, 1.912607,
+                  5.579082],
+             99: [15.149472, 1.326122, 34.586482, 0.79303, 0.231192, 3.221955, 18.587446, 0.824677, 0.84394,
+                  1.697445, 24.401515, 0.305732, 0.184354, 0.522603, 22.742609, 0.252038, 0.485598, 3.259434,
+                  5.03188]}
+    worst = max(abs(a - b) for i, x in study.items() for a, b in zip(pts[i], x))
+    check(len(pts) == 128 and worst < 6e-7,
+          f"sample --n 127 --seed 5 gives the study's points 73, 97, 99 (worst difference {worst:.1e})")
+    r = subprocess.run([sys.executable, SCRIPT, "config", "--x", ",".join(repr(v) for v in g6.incumbent()),
+                        "--runs", "256", "--budget", "50"], capture_output=True, text=True)
+    shipped = open(os.path.join(ROOT, "configs", "studies", "mu03", "f3_mu03_g6_local.yaml")).read()
+    body = "".join(l for l in shipped.splitlines(keepends=True) if not l.startswith("#"))
+    check(r.returncode == 0 and r.stdout == body,
+          "config --x INCUMBENT --runs 256 --budget 50 = configs/studies/mu03/f3_mu03_g6_local.yaml below its header")
+
+
 def through_abuopt(abuopt, pts):
     starts = [("incumbent", g6.incumbent())] + [(f"LHS point {i}", pts[i]) for i in (0, 17, 41)]
     with tempfile.TemporaryDirectory() as tmp:
@@ -221,6 +247,7 @@ def main():
     os.environ["ABUOPT"] = abuopt
     pts = sampler()
     profile_of_point()
+    reproduces_study()
     through_abuopt(abuopt, pts)
     bad_input()
     print(f"{len(failures)} failure(s)")
