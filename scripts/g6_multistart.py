@@ -10,7 +10,7 @@ The family (19 variables, every dwell at the resonance speed F_BAND fixed):
 
 Steps (each resumable: an existing output is kept):
   sample   N points of a Latin hypercube over the family, repaired to be feasible on the exact constraints
-           (peak angular acceleration 2 pi * 2 |H| / dt <= 314.16 rad/s^2, T <= 19 s); the amplitude is measured
+           (peak angular acceleration 2 pi * 2 |H| / dt <= 314.16 rad/s^2, T <= 19 s); the amplitude is not repaired (screen measures it)
   screen   each point once: abuopt montecarlo on the in-sample set (LHS, seed 21, RUNS starts, mu 0.03)
   local    abuopt optimize (COBYLA, BUDGET evaluations, RUNS LHS starts) from the K best screened points
 Usage:
