@@ -10,7 +10,7 @@ The family (19 variables, every dwell at the resonance speed F_BAND fixed):
 
 Steps (each resumable: an existing output is kept):
   sample   N points of a Latin hypercube over the family, repaired to be feasible on the exact constraints
-           (peak angular acceleration 2 pi * 2 |H| / dt <= 314.16 rad/s^2, T <= 19 s); the amplitude is measured
+           (peak angular acceleration 2 pi * 2 |H| / dt <= 314.16 rad/s^2, T <= 19 s); the amplitude is not repaired (screen measures it)
   screen   each point once: abuopt montecarlo on the in-sample set (LHS, seed 21, RUNS starts, mu 0.03)
   local    abuopt optimize (COBYLA, BUDGET evaluations, RUNS LHS starts) from the K best screened points
 Usage:
@@ -285,7 +285,15 @@ def x_of_result(path):
 
 
 def cmd_config(a):
-    x = x_of_result(a.x) if a.x.endswith(".json") else [float(t) for t in a.x.split(",")]
+    if a.x.endswith(".json"):
+        x = x_of_result(a.x)
+    else:
+        try:
+            x = [float(t) for t in a.x.split(",")]
+        except ValueError as e:
+            sys.exit(f"g6_multistart.py config: --x: {e}")
+    if len(x) != len(NAMES):  # zip() in segments()/optimize_config() would silently drop extra values
+        sys.exit(f"g6_multistart.py config: --x has {len(x)} values, the family has {len(NAMES)} ({','.join(NAMES)})")
     sys.stdout.write(optimize_config(x, balls=a.balls, runs=a.runs, budget=a.budget, step=a.step, t_max=a.t_max))
 
 
