@@ -88,7 +88,7 @@ DRIVE_MADE = {"f2pi_min_T": "pi", "f2q_min_T": "pi_1hz"}
 SHAKE_OFFSET_S = 1.5
 SHAKE_DEPTH_HZ = 3.0
 SHAKE_RATE_MARGIN = 1.001  # 0.1 % inside the limit: x0 printed to 6 digits cannot start outside it
-# Stage 4c's last step (docs/studies/startup-profile.md 8.4, "The deep excursion"): the nb-ball design's first
+# Stage 4c's last step (docs/studies/startup-profile.md 8.13, the deep fast excursion): the nb-ball design's first
 # excursion replaced by a fall to each of these bottom speeds and back at the acceleration limit
 # (deepen_first_excursion), each run on the polish's starts at mu 0.03; the best one that meets the family's bounds
 # is kept when it beats the nb-ball design on those starts. Helper h-mech's hand scan (512 LHS starts, seed 21,
