@@ -48,7 +48,9 @@ kept; rerun the same command after an interruption):
      every design again on a second fresh set (seed 9002), the formulation-3 designs also at mu 0.03;
      the ball-count designs beside the 2003 profile with the same balls; the shake designs of 4c (and their start)
      at mu 0.03 on both seeds with "x better than 2003" figures, the two made with N balls (the polish and the deep
-     excursion) also with those balls beside the 2003 profile with them
+     excursion) also with those balls beside the 2003 profile with them; with contact, the designs of section 8.13
+     made outside the runner (SHIPPED: configs/studies/best/, as shipped) on both seeds beside the 2003 profile with
+     their balls and the report's two-ball one
   7. summary.md, summary.json, best/*.yaml (ready to run), plots (profiles, front, final positions, the shakes)
   8. the stop-depth families of the limit analysis (scripts/stop_depth_study.py: approach, oscillate,
      release) into OUT/stop_depth_*: --stop-depth quick (default: a subset with the published deepest
@@ -94,6 +96,13 @@ SHAKE_RATE_MARGIN = 1.001  # 0.1 % inside the limit: x0 printed to 6 digits cann
 # is kept when it beats the nb-ball design on those starts. Helper h-mech's hand scan (512 LHS starts, seed 21,
 # six balls) had its best at 22.5 Hz (17 - 26 Hz tried): the old families' excursions stopped at 25 Hz.
 DEEP_BOTTOMS_HZ = (20.0, 21.5, 22.5, 23.5, 25.0)
+# Stage 6's check of the designs shipped in configs/studies/best/ that were made outside the runner (by hand and by
+# scripts/g6_multistart.py; docs/studies/startup-profile.md 8.13): validated as shipped, with contact only (they set
+# it), so their figures come out of the one command: (name, file in configs/studies/best/, friction).
+SHIPPED = [("contact_best_19s_deep_6balls", "contact_best_19s_deep_6balls.yaml", 0.02),
+           ("contact_best_mu03_deepshake_6balls", "contact_best_mu03_deepshake_6balls.yaml", 0.03),
+           ("contact_best_mu03_twodeep_6balls", "contact_best_mu03_twodeep_6balls.yaml", 0.03),
+           ("contact_best_mu03_g6", "contact_best_mu03_g6.yaml", 0.03)]
 # The ball count of the last polish of 4c (equal total ball mass, equal_mass_balls); --shake-balls. Set from the
 # robust helper's re-optimisation of the two-shake design with N = 3..6 balls (6 balls: 12.83 against 14.12 with 2).
 SHAKE_BALLS = 6
@@ -735,7 +744,8 @@ def main():
                      + (len(DRIVE_MADE) + 1) * val_runs
                      + len(counts) * 3 * val_runs + (2 * len(f3_budget) + 1 + len(shake_budget)) * val_runs
                      + 8 * val_runs  # the shake designs' mu 0.03 on seed 9002; 4 with N balls on 2 seeds
-                     + (len(DEEP_BOTTOMS_HZ) + 1) * shake_budget[0][1])  # 4c's deep scan
+                     + (len(DEEP_BOTTOMS_HZ) + 1) * shake_budget[0][1]  # 4c's deep scan
+                     + (4 * len(SHIPPED) if contact == "hard" else 0) * val_runs)  # the shipped designs and their 2003
     st.log(f"startup study, ball contact {contact}: {n_designs} designs, about {st.evals_total} evaluations and "
            f"{st.runs_total} validation runs; output {st.out}")
 
@@ -965,6 +975,7 @@ def main():
                            contact=contact))
 
     shake = shake_validation(st, designs, table, profiles, a.shake_balls)
+    shipped = shipped_validation(st, table)
 
     # Formulation 4's designs and the 2003 profile with the same balls, on the same fresh starts.
     balls = {}
@@ -994,7 +1005,7 @@ def main():
                                                     "T": b["metrics"].get("startup_time_s"), "profile": b["profile"]})
 
     st.stage("7 summary and plots")
-    write_summary(st, designs, table, balls, best19, shake)
+    write_summary(st, designs, table, balls, best19, shake, shipped)
     if a.stop_depth != "none":
         st.stage(f"8 stop depth ({a.stop_depth})")
         stop_depth_stage(st, a.stop_depth)
@@ -1112,7 +1123,49 @@ def shake_validation(st, designs, table, profiles, nb):
     return {"start": start, "balls": nb, "designs": names, "rows": rows}
 
 
-def write_summary(st, designs, table, balls, best19, shake=None):
+def balls_of(text):
+    """[(mass_kg, diameter_m)] of a config's `abu.balls` list (flow-style entries, as the shipped configs write them);
+    ValueError when it has none."""
+    b = [(float(m), float(d)) for m, d in re.findall(
+        r"^\s*-\s*\{\s*mass_kg:\s*([-+\d.eE]+)\s*,\s*diameter_m:\s*([-+\d.eE]+)\s*\}", text, re.M)]
+    if not b:
+        raise ValueError("the config has no abu.balls list")
+    return b
+
+
+def shipped_validation(st, table):
+    """Stage 6 for SHIPPED (contact hard only: the configs set it): each design as shipped at its friction on seeds 9001
+    and 9002 ({val-runs} random starts), beside the 2003 profile with the same balls on the same starts (paired) and
+    the report's two-ball 2003 profile of `table` at that friction and seed (x better). Returns the summary's rows."""
+    if st.a.contact != "hard":
+        return []
+    val_dir, rows = os.path.join(st.out, "validation"), []
+    for name, fname, mu in SHIPPED:
+        text = read(os.path.join(ROOT, "configs", "studies", "best", fname))
+        bl = balls_of(text)
+        # one reference per ball set and friction, shared by the designs with those balls (its text must not name one)
+        tag = "_".join(f"{m:.4g}kg{d * 1e3:.4g}mm" for m, d in sorted(set(bl))) + f"x{len(bl)}"
+        ref = run_config(report_profile(), f"the 2003 report's final profile with the balls {tag}", balls=bl,
+                         contact="hard")
+        for seed, sfx in ((VALIDATION_SEED, ""), (SECOND_SEED, "_s9002")):
+            extra, d_name, r_name = ["--mu", f"{mu:g}"], f"shipped_{name}{sfx}", f"shipped_2003_{tag}_mu{mu:g}{sfx}"
+            d = st.montecarlo(d_name, text, st.a.val_runs, seed, extra)
+            r = st.montecarlo(r_name, ref, st.a.val_runs, seed, extra)
+            key = ("ideal" if mu == 0.02 else "mu0.03") if seed == VALIDATION_SEED else ("s9002" if mu == 0.02 else
+                                                                                         "mu0.03_s9002")
+            two = table["report_2003"][key]["ir"]["mean"] if mu in (0.02, 0.03) else float("nan")
+            rows.append({"design": name, "balls": len(bl), "mu": mu, "seed": seed, "ir": d["ir"], "irx": d["irx"],
+                         "ok": d["ok"], "amp_max_mm": d["amp_max_mm"], "ref2003": r["ir"]["mean"],
+                         "ref2003_amp_max_mm": r["amp_max_mm"],
+                         "paired": paired_of(os.path.join(val_dir, d_name), os.path.join(val_dir, r_name)),
+                         "ref2003_2balls": two, "x_better_2balls": two / d["ir"]["mean"]})
+            st.log(f"[shipped] {name} ({len(bl)} balls, mu {mu:g}, seed {seed}): {d['ir']['mean']:.2f} "
+                   f"[{d['ir']['lo']:.2f}, {d['ir']['hi']:.2f}], %MI {d['ir']['pct_mi']:.2f} %; 2003 same balls "
+                   f"{r['ir']['mean']:.2f}, two balls {two:.2f}: {two / d['ir']['mean']:.3f} x")
+    return rows
+
+
+def write_summary(st, designs, table, balls, best19, shake=None, shipped=()):
     out = st.out
     n_val = table["report_2003"]["ideal"]["runs"]
     lines = [f"# Startup-profile study, ball contact {st.a.contact}: validation ({n_val} fresh random starts, seed "
@@ -1214,6 +1267,17 @@ def write_summary(st, designs, table, balls, best19, shake=None):
             lines.append(f"| {r['design']} | {r['balls']} | {r['T']:.2f} | {ins} | {r['seed']} | "
                          f"{r['mean']:.2f} [{r['lo']:.2f}, {r['hi']:.2f}] | {r['ref2003']:.2f} | {fmt_paired(r['paired'])} | "
                          f"{r['x_better']:.3f} | {r['x_better_2balls']:.3f} |")
+    if shipped:
+        lines += ["", f"## The shipped designs made outside the runner (configs/studies/best/, section 8.13; {n_val} fresh "
+                  "starts per seed, as shipped)", "",
+                  "\"x better\": the report's two-ball 2003 profile's mean |I_r| at that friction and seed over the "
+                  "design's; \"vs 2003\": paired against the 2003 profile with the design's balls.", "",
+                  "| design | balls | mu | seed | mean \\|I_r\\| | %MI \\|I_r\\| | mean I_r,x | peak amplitude [mm] (2003) | "
+                  "2003 same balls | vs 2003 | x better than the two-ball 2003 profile |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+        for r in shipped:
+            lines.append(f"| {r['design']} | {r['balls']} | {r['mu']:g} | {r['seed']} | {fmt_ir(r['ir'])} | "
+                         f"{fmt_mi(r['ir'])} | {fmt_ir(r['irx'])} | {r['amp_max_mm']:.4f} ({r['ref2003_amp_max_mm']:.4f}) | "
+                         f"{r['ref2003']:.2f} | {fmt_paired(r['paired'])} | {r['x_better_2balls']:.3f} |")
     with open(os.path.join(out, "summary.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     js = {"contact": st.a.contact, "best19": best19, "table": {n: {k: v for k, v in r.items()} for n, r in table.items()},
@@ -1221,7 +1285,8 @@ def write_summary(st, designs, table, balls, best19, shake=None):
           "f2_pi": {k: v for k, v in designs.get("f2pi_min_T", {}).items() if k in ("steps", "ref", "T")},
           "f2_pi1hz": {k: v for k, v in designs.get("f2q_min_T", {}).items() if k in ("steps", "ref", "T")},
           "stage_cost": st.stage_cost,
-          "balls": {f"{k[0]}_{k[1]}": v for k, v in balls.items()}, "shake": shake or {}}
+          "balls": {f"{k[0]}_{k[1]}": v for k, v in balls.items()}, "shake": shake or {},
+          "shipped": list(shipped)}
     with open(os.path.join(out, "summary.json"), "w") as f:
         json.dump(js, f, indent=1)
     make_plots(st, table, designs, best19)

@@ -275,6 +275,17 @@ def end_to_end(abuopt, tmp):
           and all(len(re.findall(r"^    - \{mass_kg", x, re.M)) == 3 for x in (s3, b3))
           and not re.search(r"mass_kg", s2), "stage 4c: one and two shakes, the last polish and its best/ config with 3 balls")
     check("## Shakes at mu 0.03" in study.read(os.path.join(out, "summary.md")), "summary.md has the shake table")
+    # the designs shipped from outside the runner (8.13), as shipped, on both seeds, beside the 2003 profile with
+    # their balls (paired) and the report's two balls at their friction
+    sp = s["shipped"]
+    want_rows = {(n, seed) for n, _, _ in study.SHIPPED for seed in (9001, 9002)}
+    check({(r["design"], r["seed"]) for r in sp} == want_rows and len(sp) == 2 * len(study.SHIPPED)
+          and all(r["ok"] == 8 and r["balls"] == 6 and r["paired"]["n"] == 8 and r["x_better_2balls"] > 0
+                  and abs(r["x_better_2balls"] - r["ref2003_2balls"] / r["ir"]["mean"]) < 1e-12 for r in sp)
+          and {r["mu"] for r in sp if r["design"] == "contact_best_19s_deep_6balls"} == {0.02}
+          and "## The shipped designs made outside the runner" in study.read(os.path.join(out, "summary.md"))
+          and "--mu 0.03" in study.read(os.path.join(out, "validation", "shipped_contact_best_mu03_g6", "config.yaml")),
+          f"the shipped 8.13 designs validated as shipped on both seeds ({len(sp)} rows)")
     for fam in ("approach", "oscillate", "release"):
         md = os.path.join(out, f"stop_depth_{fam}", "stop_depth" + ("" if fam == "approach" else "_osc" if fam ==
                                                                        "oscillate" else "_release") + ".md")
