@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <memory>
 #include <random>
+#include <utility>
 
 #include "abuopt/core/ball_contact.hpp"
 #include "sim_contact.hpp"
@@ -246,30 +247,28 @@ TEST(ContactModeChoice, ASlowlySeparatingPairIsNotJoinedAnApproachingOneIs) {
   s.W = 2 * M_PI * 28.9 / nd.omega_n;
   s.forced.assign(2, 0);
   s.touching = {1, 0};
+  // The mode choice at an event where ball `slipping` slides back at -v and the other is at rest; the pair was
+  // apart (or cut) before it: two clusters. Returns the run state (modes, links) and the speeds chosen.
+  const auto choose = [&](int slipping, double v) {
+    EventState a = s;
+    a.y[lay.beta_dot(slipping)] = -v;
+    auto rs = make_run_state(a);
+    rs->cs.closed.assign(2, 0);
+    detail::build_clusters(*rs);
+    std::vector<double> y = a.y;
+    detail::choose_contact_modes(*rs, a.W, a.Wp, y, a.forced);
+    return std::make_pair(std::move(rs), y);
+  };
   for (const double v : {1e-11, 1e-14}) {
-    // separating: rear (ball 0) slips back at -v, front (ball 1) at rest
-    {
-      EventState a = s;
-      a.y[lay.beta_dot(0)] = -v;
-      auto rs = make_run_state(a);
-      rs->cs.closed.assign(2, 0);  // two clusters: the pair was apart (or cut) before this event
-      detail::build_clusters(*rs);
-      std::vector<double> y = a.y;
-      detail::choose_contact_modes(*rs, a.W, a.Wp, y, a.forced);
+    {  // separating: rear (ball 0) slips back at -v, front (ball 1) at rest
+      const auto [rs, y] = choose(0, v);
       EXPECT_EQ(y[lay.beta_dot(0)], -v) << v;
       EXPECT_EQ(y[lay.beta_dot(1)], 0.0) << v;
       EXPECT_EQ(rs->cs.closed[0] + rs->cs.closed[1], 0) << v;
       EXPECT_EQ(rs->modes[0], BallMode::SlipBackward) << v;
     }
-    // approaching: front (ball 1) slips back at -v onto the rear ball at rest
-    {
-      EventState a = s;
-      a.y[lay.beta_dot(1)] = -v;
-      auto rs = make_run_state(a);
-      rs->cs.closed.assign(2, 0);  // two clusters: the pair was apart (or cut) before this event
-      detail::build_clusters(*rs);
-      std::vector<double> y = a.y;
-      detail::choose_contact_modes(*rs, a.W, a.Wp, y, a.forced);
+    {  // approaching: front (ball 1) slips back at -v onto the rear ball at rest
+      const auto [rs, y] = choose(1, v);
       EXPECT_NEAR(y[lay.beta_dot(0)], -0.5 * v, 1e-16 * v) << v;
       EXPECT_EQ(y[lay.beta_dot(0)], y[lay.beta_dot(1)]) << v;
     }
