@@ -20,7 +20,7 @@ struct SimCounters {
   long root_evaluations = 0;  // evaluations of the root functions (each costs about one RHS)
   long polishes = 0;          // roots refined on the Runge-Kutta solution (hard contact)
   long polish_steps = 0;      // the Runge-Kutta steps those refinements took
-  long dips = 0;              // hard contact: gaps that closed and opened again inside one step
+  long dips = 0;              // hard contact: gaps (or stops, 11.11) that crossed and back inside one step
   // Hard contact: choices of clusters and modes at events (sim_contact_modes.cpp), the flips of
   // the pivoting, and the choices where pivoting failed and every joint option was enumerated.
   long mode_choices = 0;
