@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 
+#include "abuopt/core/sim_counters.hpp"
 #include "sim_contact.hpp"
 
 namespace abuopt::detail {
@@ -256,6 +257,7 @@ int handle_contact_event(RunState& rs, double tbar, std::vector<double>& y, cons
     y[lay.beta(rear)] += 0.5 * gk;
     y[lay.beta(front)] -= 0.5 * gk;
     cs.max_correction = std::max(cs.max_correction, -gk);
+    sim_counters().max_gap_correction = std::max(sim_counters().max_gap_correction, -gk);
   }
   const Speed sp = rs.pi_motor ? sp0 : ideal_speed(rs, tbar);
   // the switch model chooses with its band (balls chosen stuck get zero speed, as at its impacts)
