@@ -68,6 +68,9 @@ int main(int argc, char** argv) {
               min_clearance, events / runs, 1e3 * cpu / runs, c.mode_choices,
               c.mode_choices ? static_cast<double>(c.mode_pivots) / static_cast<double>(c.mode_choices) : 0.0,
               c.mode_fallbacks);
+  // the largest overlap projected at any event (docs/model.md 11.11: ~1e-12 when every event is
+  // located) and the roots found inside a step from their rates (gaps and stops)
+  std::printf(", largest overlap projected %.2g rad, %ld dips", c.max_gap_correction, c.dips);
   if (method == "compare")
     std::printf(", the enumeration's choice differs in %ld (it is consistent in %ld)", c.mode_differs,
                 c.mode_enum_consistent);
