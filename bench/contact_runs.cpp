@@ -50,7 +50,12 @@ int main(int argc, char** argv) {
   for (int k = 0; k < runs; ++k) {
     std::vector<double> beta(n);
     for (double& x : beta) x = u(rng);
+    const double corr_before = abuopt::sim_counters().max_gap_correction;
+    abuopt::sim_counters().max_gap_correction = 0;
     const abuopt::RunOutcome o = sim.run(beta);
+    const double corr = abuopt::sim_counters().max_gap_correction;
+    if (corr > 1e-9) std::printf("run %d: an overlap of %.2g rad projected at an event\n", k, corr);
+    abuopt::sim_counters().max_gap_correction = std::max(corr_before, corr);
     if (!o.ok()) {
       ++failed;
       std::printf("run %d: %s\n", k, o.message.c_str());
