@@ -62,6 +62,8 @@ ErkStepper::ErkStepper(ButcherTable table, std::size_t n, RhsFn f, RootFn g, std
   hint_.resize(nroots);
   gd0_.assign(nroots, 0.0);
   gd1_.assign(nroots, 0.0);
+  dr0_.assign(nroots, 0.0);
+  dr1_.assign(nroots, 0.0);
   bt_.resize(nroots);
   bg_.resize(nroots);
   gtmp_.resize(nroots);
@@ -82,6 +84,7 @@ void ErkStepper::reset(double t, const double* y) {
     g_(t_, y_.data(), g0_.data(), user_);
     ++ctr_.root_evaluations;
     if (gd_) gd_(t_, y_.data(), gd0_.data(), user_);
+    if (dr_) dr_(t_, y_.data(), f0_.data(), dr0_.data(), user_);
   }
   if (h_ <= 0) h_ = initial_step();
   tprev_ = t_;
@@ -188,7 +191,7 @@ ErkStepper::Status ErkStepper::step() {
     bt_[k] = t_;
     bg_[k] = g1_[k];
   }
-  if (gd_) find_dips();
+  if (gd_ || dr_) find_dips();
   double troot = t_ + 1.0;
   int first = -1;
   for (std::size_t k = 0; k < nroots_; ++k) {
@@ -212,6 +215,7 @@ ErkStepper::Status ErkStepper::step() {
   if (first < 0) {
     g0_.swap(g1_);
     gd0_.swap(gd1_);
+    dr0_.swap(dr1_);
     return t_ >= tstop_ ? StopReached : Ok;
   }
   if (polish_) {
@@ -270,15 +274,18 @@ ErkStepper::Status ErkStepper::step() {
 }
 
 void ErkStepper::find_dips() {
-  gd_(t_, y_.data(), gd1_.data(), user_);
+  if (gd_) gd_(t_, y_.data(), gd1_.data(), user_);
+  if (dr_) dr_(t_, y_.data(), f0_.data(), dr1_.data(), user_);  // f at the step's end (FSAL)
   const double h = t_ - tprev_;
   for (std::size_t k = 0; k < nroots_; ++k) {
     const double g0 = g0_[k], g1 = g1_[k];
     if (g0 == 0.0 || g1 == 0.0 || (g0 < 0) != (g1 < 0)) continue;  // no dip: zero or a sign change
     const double s = g0 < 0 ? -1.0 : 1.0;
-    if (!(s * gd0_[k] < 0 && s * gd1_[k] > 0)) continue;  // not towards zero, then away
+    // the rate known for k: a gap's (gd_) or one from f (dr_); the two fill disjoint entries
+    const double r0 = gd0_[k] + dr0_[k], r1 = gd1_[k] + dr1_[k];
+    if (!(s * r0 < 0 && s * r1 > 0)) continue;  // not towards zero, then away
     // the interpolant g0 + a1 u + a2 u^2 + a3 u^3 on u in [0, 1]; its slope changes sign once
-    const double a1 = h * gd0_[k], a2 = 3 * (g1 - g0) - h * (2 * gd0_[k] + gd1_[k]), a3 = 2 * (g0 - g1) + h * (gd0_[k] + gd1_[k]);
+    const double a1 = h * r0, a2 = 3 * (g1 - g0) - h * (2 * r0 + r1), a3 = 2 * (g0 - g1) + h * (r0 + r1);
     double lo = 0, hi = 1;
     for (int it = 0; it < 60; ++it) {
       const double mid = 0.5 * (lo + hi);

@@ -29,6 +29,9 @@ struct ButcherTable {
 
 using RhsFn = void (*)(double t, const double* y, double* dydt, void* user);
 using RootFn = void (*)(double t, const double* y, double* g, void* user);
+// Rates of root functions computed from the state and its derivative dydt = f(t, y) (e.g. a
+// function that is a state component: its rate is that component of f).
+using RateFn = void (*)(double t, const double* y, const double* dydt, double* gd, void* user);
 
 // A located event's gap error allowed, as a fraction of the absolute state tolerance atol
 // (docs/model.md 11.9): the time tolerance of a gap's root is atol * kEventGapTol / |its rate|.
@@ -58,6 +61,12 @@ class ErkStepper {
   // functions linear in the state (ball-ball gaps), and if the extremum is across zero on the
   // Runge-Kutta solution, the crossing before it is a root like any other.
   void set_root_rates(RootFn gd) { gd_ = gd; }
+  // Rates from the right-hand side, for the dip check only (docs/model.md 11.11): at the step's
+  // ends f is known (the step's start and its FSAL end), so they cost no extra evaluation. These
+  // functions are not polished by Newton (their rate at an inner time would need f there); a dip
+  // found with them is refined like a function without rate. gd_ and dr_ fill disjoint entries
+  // (0 for the functions they do not know).
+  void set_dip_rates(RateFn dr) { dr_ = dr; }
   // Takes one accepted step (never past the stop time). On Root, t()/y() are at the earliest
   // root and roots_found()[k] != 0 marks the functions that crossed there.
   Status step();
@@ -107,6 +116,8 @@ class ErkStepper {
   std::vector<double> g0_, g1_, gtmp_, groot_, hint_;
   RootFn gd_ = nullptr;
   std::vector<double> gd0_, gd1_;  // root function rates at the step's ends (with gd_)
+  RateFn dr_ = nullptr;
+  std::vector<double> dr0_, dr1_;  // rates from f at the step's ends (with dr_)
   std::vector<double> bt_, bg_;    // per function: the end of its bracket [tprev, bt] and g there
   std::vector<std::size_t> order_;
   std::vector<int> found_;

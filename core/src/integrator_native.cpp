@@ -16,7 +16,10 @@ class NativeIntegrator final : public Integrator {
       : st_(table_for(rs.opt.erk_table), nvar, rhs_plain,
             with_roots ? (rs.contact ? roots_contact : roots_plain) : nullptr, with_roots ? rs.nroots() : 0, &rs, rs.opt.rtol, rs.opt.atol, rs.opt.max_steps) {
     st_.set_polish_roots(rs.contact);  // contact events need exact times (docs/model.md 11.5)
-    if (with_roots && rs.contact) st_.set_root_rates(root_rates_contact);  // gaps that close and open in a step
+    if (with_roots && rs.contact) {
+      st_.set_root_rates(root_rates_contact);  // gaps that close and open in a step
+      st_.set_dip_rates(stop_rates_contact);   // clusters that reverse and back in a step (11.11)
+    }
   }
   void reset(double t, const std::vector<double>& y) override { st_.reset(t, y.data()); }
   void set_stop(double t) override { st_.set_stop_time(t); }

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 
+#include "abuopt/core/sim_counters.hpp"
 #include "sim_contact.hpp"
 
 namespace abuopt::detail {
@@ -125,6 +126,26 @@ void root_rates_contact(double, const double* y, double* gd, void* user) {
     gd[2 * rs.n + k] = cs.closed[k] ? 0.0 : rate(cs.geo.order[(k + 1) % rs.n]) - rate(cs.geo.order[k]);
 }
 
+// The slipping clusters' stop functions sigma beta_f' (f: the cluster's front ball) have the rate
+// sigma beta_f'' = sigma dydt[beta_dot(f)], from the right-hand side the stepper has at a step's
+// ends (docs/model.md 11.11): a cluster that reverses and back inside one step is then found by
+// the dip check. Only for the dip check (ErkStepper::set_dip_rates), never for Newton polishing.
+// Everything else 0 (margins, contact forces, gaps: their rates are root_rates_contact's or none).
+void stop_rates_contact(double, const double* y, const double* dydt, double* gd, void* user) {
+  (void)y;
+  const auto& rs = *static_cast<const RunState*>(user);
+  const StateLayout& lay = rs.lay();
+  const ContactState& cs = rs.cs;
+  std::fill(gd, gd + 2 * rs.n + cs.geo.pairs(), 0.0);
+  if (switch_model(rs)) return;  // its functions 0 .. 2n-1 are constants
+  for (const auto& grp : cs.clusters.groups) {
+    const BallMode mode = rs.modes[grp.front()];
+    if (mode == BallMode::Stick) continue;
+    const std::size_t f = grp.back();
+    gd[2 * f] = static_cast<double>(static_cast<signed char>(mode)) * dydt[lay.beta_dot(f)];
+  }
+}
+
 // Functions that start at or below zero by rounding are shifted so their later crossing is seen.
 void set_contact_root_offsets(RunState& rs, double tbar, const double* y) {
   const StateLayout& lay = rs.lay();
@@ -236,6 +257,7 @@ int handle_contact_event(RunState& rs, double tbar, std::vector<double>& y, cons
     y[lay.beta(rear)] += 0.5 * gk;
     y[lay.beta(front)] -= 0.5 * gk;
     cs.max_correction = std::max(cs.max_correction, -gk);
+    sim_counters().max_gap_correction = std::max(sim_counters().max_gap_correction, -gk);
   }
   const Speed sp = rs.pi_motor ? sp0 : ideal_speed(rs, tbar);
   // the switch model chooses with its band (balls chosen stuck get zero speed, as at its impacts)

@@ -127,6 +127,9 @@ void roots_contact(double tbar, const double* y, double* g, void* user);
 // The rates of the contact root functions where known: d gap_k / dtbar for open pairs, 0 for the
 // rest (the stepper's dip check, erk_stepper.hpp).
 void root_rates_contact(double tbar, const double* y, double* gd, void* user);
+// The slipping clusters' stop functions' rates from the right-hand side dydt, 0 for the rest (the
+// dip check only, docs/model.md 11.11).
+void stop_rates_contact(double tbar, const double* y, const double* dydt, double* gd, void* user);
 void set_contact_root_offsets(RunState& rs, double tbar, const double* y);
 // Chooses clusters and modes at an instant: balls at zero relative speed and zero gap may form or
 // leave clusters, clusters at zero speed may stick or slip. forced[i] != 0: the cluster of ball i

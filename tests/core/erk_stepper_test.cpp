@@ -276,6 +276,77 @@ TEST(ErkStepper, ARootFunctionThatDipsThroughZeroInsideAStepIsFoundWithItsRate) 
 }
 
 namespace {
+// A sliding ball's speed that reverses and back (docs/model.md 11.11): v(t) = a (t - t1) (t - t2)
+// with a = 0.5, t1 = 0.1 - sqrt(0.008), t2 = 0.1 + sqrt(0.008) (the parabola above), as the state
+// (v, w = v'), w' = 2 a = 1. The stop function is sigma v (sigma = +1: slipping forward); its rate
+// is sigma v' = the component 0 of the right-hand side, given to the dip check only (a RateFn
+// from dydt, as the simulator's stop functions), so the root is refined without Newton.
+void speed_rhs(double, const double* y, double* yd, void*) {
+  yd[0] = y[1];
+  yd[1] = 1.0;
+}
+void stop_fn(double, const double* y, double* g, void*) { g[0] = y[0]; }
+void stop_rate(double, const double*, const double* dydt, double* gd, void*) { gd[0] = dydt[0]; }
+}  // namespace
+
+TEST(ErkStepper, ASpeedThatReversesAndBackInsideAStepIsStoppedWithItsRateFromTheRhs) {
+  // As for the gap above: from t = -20 to a stop time at -0.2, then one step to 1 over both zeros
+  // of v. Without dip rates (contact model version 4: only gaps had rates) the stop is missed;
+  // with the rate from f at the step's ends the minimum on the interpolant (exact: v is a state
+  // component, its Hermite interpolant has v' from f) is below zero on the Runge-Kutta solution,
+  // and the first zero is refined by Illinois to 2 ulp of the time: within 1e-11 of t1 (the
+  // rounding of v(-20) ~ 3e-14 over the slope |v'(t1)| = 0.089), the speed at the event within
+  // 1e-12 of 0, and no Newton iteration (no rate from set_root_rates).
+  auto v_at = [](double t) { return 1e-3 - 0.1 * t + 0.5 * t * t; };
+  const double y0[2] = {v_at(-20.0), -0.1 - 20.0};
+  const double t1 = 0.1 - std::sqrt(0.008);
+  for (bool rates : {false, true}) {
+    ErkStepper st(ButcherTable::from_arkode("ARKODE_FEHLBERG_13_7_8"), 2, speed_rhs, stop_fn, 1, nullptr, 1e-6, 1e-9,
+                  1000);
+    st.set_polish_roots(true);
+    if (rates) st.set_dip_rates(stop_rate);
+    st.reset(-20.0, y0);
+    st.set_stop_time(-0.2);
+    ErkStepper::Status s = ErkStepper::Ok;
+    while (s == ErkStepper::Ok) s = st.step();
+    ASSERT_EQ(s, ErkStepper::StopReached);
+    st.set_stop_time(1.0);
+    const abuopt::SimCounters before = abuopt::sim_counters();
+    s = st.step();
+    if (!rates) {
+      EXPECT_EQ(s, ErkStepper::StopReached);  // the missed stop of version 4
+      EXPECT_EQ(st.t(), 1.0);
+      EXPECT_GT(st.y()[0], 0.0);
+      continue;
+    }
+    ASSERT_EQ(s, ErkStepper::Root);
+    EXPECT_NEAR(st.t(), t1, 1e-11);
+    EXPECT_NEAR(st.y()[0], 0.0, 1e-12);
+    EXPECT_EQ(st.roots_found()[0], 1);
+    EXPECT_EQ(abuopt::sim_counters().dips - before.dips, 1);
+    EXPECT_EQ(abuopt::sim_counters().polishes - before.polishes, 1);
+  }
+}
+
+// A function that moves towards zero and turns away before reaching it (v stays > 0) is not a
+// stop: the minimum is checked on the Runge-Kutta solution, so no false stop (a ball whose speed
+// only approaches zero keeps slipping).
+TEST(ErkStepper, ASpeedThatOnlyApproachesZeroIsNotStopped) {
+  auto v_at = [](double t) { return 1e-2 - 0.1 * t + 0.5 * t * t; };  // minimum 5e-3 at t = 0.1
+  const double y0[2] = {v_at(-20.0), -0.1 - 20.0};
+  ErkStepper st(ButcherTable::from_arkode("ARKODE_FEHLBERG_13_7_8"), 2, speed_rhs, stop_fn, 1, nullptr, 1e-6, 1e-9,
+                1000);
+  st.set_polish_roots(true);
+  st.set_dip_rates(stop_rate);
+  st.reset(-20.0, y0);
+  st.set_stop_time(1.0);
+  ErkStepper::Status s = ErkStepper::Ok;
+  while (s == ErkStepper::Ok) s = st.step();
+  EXPECT_EQ(s, ErkStepper::StopReached);
+  EXPECT_EQ(st.t(), 1.0);
+}
+
+namespace {
 // A gap closing on a known trajectory: y = (sin t, cos t); the "gap" g = 0.8 - y0 (a ball at
 // sin t approaching a resting ball at 0.8) closes at t* = asin(0.8), at the rate g' = -y1 = -0.6.
 void closing_gap(double, const double* y, double* g, void*) { g[0] = 0.8 - y[0]; }

@@ -11,7 +11,9 @@ namespace abuopt {
 // direction whose margin crossed (docs/model.md 11.8); 3: gap events located by Newton on the
 // Runge-Kutta solution to a derived tolerance instead of 2 ulp (docs/model.md 11.9); 4: a touching
 // pair that separates is joined at an event only if its speeds agree to 1e-9 relative, not 1e-9
-// absolute (the Zeno chatter of slow chains, docs/model.md 11.10).
-inline constexpr int kContactModelVersion = 4;
+// absolute (the Zeno chatter of slow chains, docs/model.md 11.10); 5: a slipping cluster that
+// reverses and back inside one step is stopped (its stop function's rate from the right-hand side
+// in the dip check, docs/model.md 11.11).
+inline constexpr int kContactModelVersion = 5;
 
 }  // namespace abuopt

@@ -20,7 +20,10 @@ struct SimCounters {
   long root_evaluations = 0;  // evaluations of the root functions (each costs about one RHS)
   long polishes = 0;          // roots refined on the Runge-Kutta solution (hard contact)
   long polish_steps = 0;      // the Runge-Kutta steps those refinements took
-  long dips = 0;              // hard contact: gaps that closed and opened again inside one step
+  long dips = 0;              // hard contact: gaps (or stops, 11.11) that crossed and back inside one step
+  // hard contact: the largest overlap (negative gap) projected away at an event [rad] (11.5: at
+  // most ~1e-12 when every event is located; docs/model.md 11.10 - 11.11)
+  double max_gap_correction = 0;
   // Hard contact: choices of clusters and modes at events (sim_contact_modes.cpp), the flips of
   // the pivoting, and the choices where pivoting failed and every joint option was enumerated.
   long mode_choices = 0;
