@@ -10,7 +10,7 @@ active `ball_contact: hard` with --contact hard and is left byte-identical with 
 study replays its archives); abuopt accepts the generated configs; the equal-mass ball sets have the closed-form
 masses and diameters; the paired difference is the mean of the run-by-run differences; an output folder of one
 contact setting is refused with the other.
-end_to_end: every stage runs and writes its outputs (stage 4c with --shake-balls 3), every optimised and validated
+end_to_end: every stage runs and writes its outputs (stage 4c with --shake-balls 3, stage 5c's chain), every optimised and validated
 config carries the contact setting, and a second run replays every evaluation from the archives (nothing computed).
 """
 import csv
@@ -363,6 +363,29 @@ def end_to_end(abuopt, tmp):
           and "## The shipped designs made outside the runner" in study.read(os.path.join(out, "summary.md"))
           and "--mu 0.03" in study.read(os.path.join(out, "validation", "shipped_contact_best_mu03_g6", "config.yaml")),
           f"the shipped 8.13 designs validated as shipped on both seeds ({len(sp)} rows)")
+    # stage 5c: the mean-goal chain from the k4_hold design (six balls, mu 0.02): the up-shake polish, the scan (the
+    # shaken design and every (offset, bottom) that fits its dwell) on the polish's LHS starts, the deep polish; its
+    # design within the bounds, in best/ and validated on both seeds beside the 2003 profile with six balls (paired)
+    mg = s["mean_goal"]
+    scan5c = [x for x in os.listdir(os.path.join(out, "validation")) if x.startswith("mean_goal_")]
+    npoints = 1 + len(study.MEAN_GOAL_OFFSETS_S) * len(study.MEAN_GOAL_BOTTOMS_HZ)
+    made = study.read(os.path.join(out, "best", "runner_mean_goal_6balls.yaml"))
+    segs5c = study.segments_of(mg["profile"]) if mg else []
+    ends = [0.0] + [f for f, _ in segs5c]
+    check(mg and {(r["design"], r["seed"]) for r in mg["rows"]} == {("runner_mean_goal_6balls", 9001),
+                                                                     ("runner_mean_goal_6balls", 9002)}
+          and all(r["ok"] == 8 and r["balls"] == 6 and r["mu"] == 0.02 and r["paired"]["n"] == 8 for r in mg["rows"])
+          and len(re.findall(r"^    - \{mass_kg", made, re.M)) == 6 and active_contact_lines(made) == ["hard"]
+          and sum(dt for _, dt in segs5c) <= 19 + 1e-9
+          and max(study.peak_rate(f - e, dt) for (f, dt), e in zip(segs5c, ends)) <= study.MAX_RATE_HZ_S
+          and "(made by the runner, stage 5c)" in study.read(os.path.join(out, "summary.md"))
+          and len(re.findall(r"^    - \{mass_kg", study.read(os.path.join(out, "f1_mu02_shake_6balls", "config.yaml")),
+                             re.M)) == 6
+          and "mean_goal_shaken" in scan5c and npoints - 3 <= len([x for x in scan5c if "Hz_at" in x]) + 1 <= npoints
+          and "# runs 5 seed 21 --mu 0.02 design lhs" in study.read(os.path.join(out, "validation", "mean_goal_shaken",
+                                                                                 "config.yaml")),
+          f"stage 5c: {mg.get('point') if mg else None}, T {sum(dt for _, dt in segs5c):.3f} s, {len(scan5c)} points run, "
+          "validated on both seeds with six balls")
     for fam in ("approach", "oscillate", "release"):
         md = os.path.join(out, f"stop_depth_{fam}", "stop_depth" + ("" if fam == "approach" else "_osc" if fam ==
                                                                        "oscillate" else "_release") + ".md")
@@ -372,7 +395,7 @@ def end_to_end(abuopt, tmp):
           "formulation 2 minimises startup_time with the max_mean_abs_ir bound")
     cost = json.load(open(os.path.join(out, "stage_cost.json")))
     stages = [c["stage"] for c in cost]
-    check(len(stages) == 12 and all(c["cpu_s"] >= 0 and c["wall_s"] >= 0 for c in cost) and cost[0]["cpu_s"] > 0
+    check(len(stages) == 13 and all(c["cpu_s"] >= 0 and c["wall_s"] >= 0 for c in cost) and cost[0]["cpu_s"] > 0
           and "[cost] whole study: CPU" in r.stdout, f"the cost of every stage is recorded: {stages}")
     configs = [os.path.join(d, "config.yaml") for d in
                [os.path.join(out, x) for x in os.listdir(out)] + [os.path.join(out, "validation", x) for x in
