@@ -754,6 +754,20 @@ def segments_of_x(text, x):
     return segs
 
 
+def fit_duration(x, bounds, t_max):
+    """x with its durations dt<i> summing to at most t_max when they can: the excess (clipping into the family's bounds
+    can lengthen a short dwell) taken from the longest durations first, each kept at its lower bound. Pure."""
+    x = dict(x)
+    excess = sum(v for k, v in x.items() if k.startswith("dt")) - t_max
+    for k in sorted((k for k in x if k.startswith("dt")), key=lambda k: -x[k]):
+        if excess <= 0:
+            break
+        cut = min(excess, x[k] - bounds[k][0])
+        x[k] -= cut
+        excess -= cut
+    return x
+
+
 def profile_dict(segs, f0=0.0):
     return {"start_frequency_hz": f0, "segments": [{"end_frequency_hz": f, "duration_s": d} for f, d in segs]}
 
@@ -785,6 +799,7 @@ def mean_goal_chain(st, start, profile, budget):
     x0, clipped = design_x(segs, base)
     if clipped:
         st.log(f"[mean goal] the up-shake start lies outside the family's bounds in {', '.join(clipped)}: clipped")
+    x0 = fit_duration(x0, bounds_of(base), t_max)
     r = st.optimize("f1_mu02_shake_6balls", set_x0(base, x0), s_evals)
     shaken = segments_of(r["best"]["profile"])
     st.log(f"[mean goal] up-shake polished with {len(balls)} balls: in sample {r['best']['objective']:.3f} "
@@ -832,7 +847,7 @@ def mean_goal_chain(st, start, profile, budget):
     steps.append({"step": "scan", "points": scan, "best": best[0], "best_within": best_all and best_all[0]})
 
     # 3. COBYLA from the scan's best (the deep family needs the excursion; from "shaken" the chain ends here)
-    final = best_all or ("shaken", shaken, scan[0]["mean"])
+    final = best_all  # None: no point within every bound yet
     if best[0] != "shaken":
         base = set_section_value(deep_text, "runs", d_runs)
         x0, clipped = design_x(best[1], base)
@@ -867,6 +882,10 @@ def mean_goal_chain(st, start, profile, budget):
                         final = ("deep_polished_repaired", segs_r, s["ir"]["mean"])
             except ValueError as e:
                 st.log(f"[mean goal] the deep polish's best could not be repaired ({e}); the scan's best stays")
+    if final is None:  # never a design over a bound: the stage has none (stage 6 validates nothing)
+        st.log("[mean goal] no point within every bound (time, amplitude, acceleration, %MI on the polish's starts): "
+               "stage 5c has no design")
+        return None
     segs = final[1]
     T = sum(dt_ for _, dt_ in segs)
     st.log(f"[mean goal] design: {final[0]}, in sample {final[2]:.3f}, T {T:.3f} s")
@@ -1519,6 +1538,8 @@ def write_summary(st, designs, table, balls, best19, shake=None, shipped=(), mea
             lines.append(f"| {r['design']} | {r['balls']} | {r['T']:.2f} | {ins} | {r['seed']} | "
                          f"{r['mean']:.2f} [{r['lo']:.2f}, {r['hi']:.2f}] | {r['ref2003']:.2f} | {fmt_paired(r['paired'])} | "
                          f"{r['x_better']:.3f} | {r['x_better_2balls']:.3f} |")
+    if st.a.contact == "hard" and not mean_goal:
+        lines += ["", "Stage 5c (the mean goal with six balls) found no point within every bound: no design."]
     if shipped:
         lines += ["", f"## The shipped designs made outside the runner (configs/studies/best/, section 8.13; {n_val} fresh "
                   "starts per seed, as shipped) and the runner's own mean-goal design (stage 5c, source runner)", "",

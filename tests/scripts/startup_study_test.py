@@ -250,6 +250,11 @@ def mean_goal(abuopt, tmp, cdir):
         check(False, "repair_rates refuses when the longest dwell cannot give the time")
     except ValueError:
         check(True, "repair_rates refuses when the longest dwell cannot give the time")
+    # fit_duration: the excess over T taken from the longest durations first, each kept at its lower bound
+    x = study.fit_duration({"f1": 25.0, "dt1": 1.0, "dt2": 0.5, "dt3": 0.3}, {"dt1": (0.9, 3), "dt2": (0.2, 3),
+                                                                           "dt3": (0.2, 3)}, 1.5)
+    check(abs(x["dt1"] - 0.9) < 1e-12 and abs(x["dt2"] - 0.3) < 1e-12 and x["dt3"] == 0.3 and x["f1"] == 25.0,
+          f"fit_duration takes 0.3 s from dt1 (to its bound 0.9) then dt2: {x}")
     # The deep family's x of that profile, read back by segments_of_x and by abuopt as the same profile.
     text = study.set_section_value(study.read(os.path.join(cdir, "mu02", "f1_mu02_deep_polish_6balls.yaml")), "runs", 4)
     x, clipped = study.design_x(deep, text)
@@ -369,10 +374,15 @@ def end_to_end(abuopt, tmp):
     mg = s["mean_goal"]
     scan5c = [x for x in os.listdir(os.path.join(out, "validation")) if x.startswith("mean_goal_")]
     npoints = 1 + len(study.MEAN_GOAL_OFFSETS_S) * len(study.MEAN_GOAL_BOTTOMS_HZ)
-    made = study.read(os.path.join(out, "best", "runner_mean_goal_6balls.yaml"))
+    made_path = os.path.join(out, "best", "runner_mean_goal_6balls.yaml")
+    made = study.read(made_path) if os.path.exists(made_path) else ""
     segs5c = study.segments_of(mg["profile"]) if mg else []
     ends = [0.0] + [f for f, _ in segs5c]
-    check(mg and {(r["design"], r["seed"]) for r in mg["rows"]} == {("runner_mean_goal_6balls", 9001),
+    # at this scale (5 starts) the chain may end with no point within every bound: then no design, nothing shipped
+    none = not mg and "stage 5c has no design" in r.stdout and not os.path.exists(
+        os.path.join(out, "best", "runner_mean_goal_6balls.yaml")) and "Stage 5c (the mean goal with six balls) found no" \
+        in study.read(os.path.join(out, "summary.md"))
+    check(none and "mean_goal_shaken" in scan5c or mg and {(r["design"], r["seed"]) for r in mg["rows"]} == {("runner_mean_goal_6balls", 9001),
                                                                      ("runner_mean_goal_6balls", 9002)}
           and all(r["ok"] == 8 and r["balls"] == 6 and r["mu"] == 0.02 and r["paired"]["n"] == 8 for r in mg["rows"])
           and len(re.findall(r"^    - \{mass_kg", made, re.M)) == 6 and active_contact_lines(made) == ["hard"]
@@ -384,8 +394,8 @@ def end_to_end(abuopt, tmp):
           and "mean_goal_shaken" in scan5c and npoints - 3 <= len([x for x in scan5c if "Hz_at" in x]) + 1 <= npoints
           and "# runs 5 seed 21 --mu 0.02 design lhs" in study.read(os.path.join(out, "validation", "mean_goal_shaken",
                                                                                  "config.yaml")),
-          f"stage 5c: {mg.get('point') if mg else None}, T {sum(dt for _, dt in segs5c):.3f} s, {len(scan5c)} points run, "
-          "validated on both seeds with six balls")
+          f"stage 5c: {mg.get('point') if mg else 'no design within the bounds'}, T {sum(dt for _, dt in segs5c):.3f} s, "
+          f"{len(scan5c)} points run, validated on both seeds with six balls (when within the bounds)")
     for fam in ("approach", "oscillate", "release"):
         md = os.path.join(out, f"stop_depth_{fam}", "stop_depth" + ("" if fam == "approach" else "_osc" if fam ==
                                                                        "oscillate" else "_release") + ".md")
