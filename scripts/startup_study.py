@@ -974,9 +974,9 @@ def main():
                     (max(2, int(60 * sc)), max(4, int(256 * sc))))
     # Stage 5c, the mean-goal chain (contact hard only): (evaluations, starts) of the six-ball shake polish, the starts of
     # the deep scan (28 points) and of the checks, (evaluations, starts) of the deep polish. A six-ball run of these 19 s
-    # profiles at mu 0.02 costs about 5 - 7 ms: about 27 000 runs, 150 - 190 s of CPU at scale 1 (measured: see
-    # docs/studies/startup-profile.md 8.13), its validation (2 x 1024 runs; the 2003 six-ball reference is the shipped
-    # deep design's) about 12 s more.
+    # profiles at mu 0.02 costs about 5 - 7 ms: about 28 000 runs, measured 175 s of CPU at scale 1 (docs/studies/
+    # startup-profile.md 8.13 "Made by the runner"), its validation (2 x 1024 runs; the 2003 six-ball reference is the
+    # shipped deep design's) about 12 s more.
     mean_budget = ((max(2, int(40 * sc)), max(4, int(256 * sc))), max(4, int(256 * sc)),
                    (max(2, int(40 * sc)), max(4, int(256 * sc))))
     mean_goal = contact == "hard"
