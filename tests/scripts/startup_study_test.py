@@ -4,12 +4,13 @@
     startup_study_test.py ABUOPT unit          # default suite, a few seconds: the --contact plumbing
     startup_study_test.py ABUOPT end_to_end    # ctest -L long: the whole study at --scale 0.02, then resumed
 
-unit: stage 4c's shake insertion against the profile it edits (shakes()); every study config gets exactly one
+unit: stage 4c's shake insertion against the profile it edits (shakes()); stage 5c's excursion, acceleration
+repair and the deep family's x (mean_goal()); every study config gets exactly one
 active `ball_contact: hard` with --contact hard and is left byte-identical with --contact none (so the no-contact
 study replays its archives); abuopt accepts the generated configs; the equal-mass ball sets have the closed-form
 masses and diameters; the paired difference is the mean of the run-by-run differences; an output folder of one
 contact setting is refused with the other.
-end_to_end: every stage runs and writes its outputs (stage 4c with --shake-balls 3), every optimised and validated
+end_to_end: every stage runs and writes its outputs (stage 4c with --shake-balls 3, stage 5c's chain), every optimised and validated
 config carries the contact setting, and a second run replays every evaluation from the archives (nothing computed).
 """
 import csv
@@ -81,6 +82,7 @@ def unit(abuopt, tmp):
         check(ok, f"abuopt montecarlo runs the validation config with contact {contact} (4 balls)")
 
     shakes(abuopt, tmp, cdir)
+    mean_goal(abuopt, tmp, cdir)
 
     # Paired difference: the mean of the run-by-run differences, over the runs ok in both.
     a, b = os.path.join(tmp, "pa"), os.path.join(tmp, "pb")
@@ -192,6 +194,86 @@ def shakes(abuopt, tmp, cdir):
               f"{best.get('metrics', {}).get('peak_angular_acceleration_rad_s2')} rad/s^2)")
 
 
+def mean_goal(abuopt, tmp, cdir):
+    """Stage 5c's pure helpers: the excursion inserted with T kept (f(t) unchanged before it, the dwell shortened by
+    its 2 d, the peak |f'| at the limit, up or down), the acceleration repair (every too-fast segment slowed to the
+    limit, the time from the longest dwell, no frequency moved, T kept), the profile of a config's x, and abuopt
+    reading the deep family's x back as the inserted profile."""
+    segs = [(23.867, 2.058), (28.915, 3.242), (28.915, 4.325), (100.0, 8.478)]  # the runner's k4_hold design
+    total = sum(dt for _, dt in segs)
+    up = study.insert_excursion(segs, 2, 2.77, 28.915 + 2.2)
+    d = study.shake_duration(2.2)
+    t_ins = 2.058 + 3.242 + 2.77
+    grid = [total * k / 4000 for k in range(4001)]
+    before = max(abs(study.frequency_at(up, t) - study.frequency_at(segs, t)) for t in grid if t <= t_ins)
+    fine = [t_ins + 2 * d * k / 2000 for k in range(2001)]
+    top = max(study.frequency_at(up, t) for t in fine)
+    rate = max(abs(study.frequency_at(up, b) - study.frequency_at(up, a)) / (b - a) for a, b in zip(fine, fine[1:]))
+    after = max(abs(study.frequency_at(up, t) - study.frequency_at(segs, t)) for t in grid if t >= t_ins + 2 * d)
+    check(abs(sum(dt for _, dt in up) - total) < 1e-12 and len(up) == 7 and study.dwells(up) == [2, 5]
+          and abs(up[5][1] - (4.325 - 2.77 - 2 * d)) < 1e-12 and before < 1e-12 and after < 1e-12
+          and abs(top - 31.115) < 1e-9
+          and study.MAX_RATE_HZ_S / study.SHAKE_RATE_MARGIN * 0.9999 < rate <= study.MAX_RATE_HZ_S,
+          f"insert_excursion up 2.2 Hz: T kept, f(t) unchanged before ({before:.1e}) and after ({after:.1e}), top "
+          f"{top:.6f} Hz, peak f' {rate:.4f} Hz/s")
+    deep = study.insert_excursion(up, 2, 0.05, 24.0)
+    dd = study.shake_duration(28.915 - 24.0)
+    check(len(deep) == 10 and abs(sum(dt for _, dt in deep) - total) < 1e-12 and deep[3] == (24.0, dd)
+          and deep[4] == (28.915, dd) and abs(deep[5][1] - (up[2][1] - 0.05 - 2 * dd)) < 1e-12
+          and abs(dd - 2 * 4.915 / study.MAX_RATE_HZ_S * study.SHAKE_RATE_MARGIN) < 1e-12,
+          f"insert_excursion down to 24 Hz 0.05 s in: 10 segments, T kept, {dd:.5f} s each way")
+    for args, what in (((segs, 1, 1.0, 25.0), "a ramp"), ((segs, 2, 0.0, 25.0), "offset 0"),
+                       ((segs, 2, 4.325, 25.0), "offset = the dwell"), ((segs, 2, 1.0, 28.915), "to = f"),
+                       ((segs, 2, 4.3, 25.0), "no time left for the excursion"), ((segs, 5, 1.0, 25.0), "index")):
+        try:
+            study.insert_excursion(*args)
+            check(False, f"insert_excursion refuses {what}")
+        except ValueError:
+            check(True, f"insert_excursion refuses {what}")
+    # repair_rates: two segments 4 % over the limit (peak 2 H / dt), the second-longest dwell untouched
+    r = study.MAX_RATE_HZ_S * 1.04
+    bad = deep[:3] + [(24.0, 2 * 4.915 / r), (28.915, 2 * 4.915 / r)] + deep[5:]
+    fixed, slowed = study.repair_rates(bad)
+    ends = [0.0] + [f for f, _ in fixed]
+    rates = [study.peak_rate(f - e, dt) for (f, dt), e in zip(fixed, ends)]
+    added = 2 * (dd - 2 * 4.915 / r)
+    longest = max(study.dwells(bad), key=lambda i: bad[i][1])
+    check(slowed == [3, 4] and max(rates) <= study.MAX_RATE_HZ_S and abs(fixed[3][1] - dd) < 1e-12
+          and [f for f, _ in fixed] == [f for f, _ in bad] and abs(sum(dt for _, dt in fixed) - sum(dt for _, dt in bad))
+          < 1e-12 and abs(fixed[longest][1] - (bad[longest][1] - added)) < 1e-12
+          and all(fixed[i] == bad[i] for i in range(len(bad)) if i not in (3, 4, longest)),
+          f"repair_rates: segments {slowed} slowed to the limit ({max(rates):.4f} Hz/s), {added:.5f} s from dwell "
+          f"{longest}, T kept")
+    check(study.repair_rates(deep) == (deep, []), "repair_rates leaves a profile within the limit unchanged")
+    try:
+        study.repair_rates([(25.0, 0.1), (25.0, 0.25), (100.0, 8.0)])
+        check(False, "repair_rates refuses when the longest dwell cannot give the time")
+    except ValueError:
+        check(True, "repair_rates refuses when the longest dwell cannot give the time")
+    # fit_duration: the excess over T taken from the longest durations first, each kept at its lower bound
+    x = study.fit_duration({"f1": 25.0, "dt1": 1.0, "dt2": 0.5, "dt3": 0.3}, {"dt1": (0.9, 3), "dt2": (0.2, 3),
+                                                                           "dt3": (0.2, 3)}, 1.5)
+    check(abs(x["dt1"] - 0.9) < 1e-12 and abs(x["dt2"] - 0.3) < 1e-12 and x["dt3"] == 0.3 and x["f1"] == 25.0,
+          f"fit_duration takes 0.3 s from dt1 (to its bound 0.9) then dt2: {x}")
+    # The deep family's x of that profile, read back by segments_of_x and by abuopt as the same profile.
+    text = study.set_section_value(study.read(os.path.join(cdir, "mu02", "f1_mu02_deep_polish_6balls.yaml")), "runs", 4)
+    x, clipped = study.design_x(deep, text)
+    back = study.segments_of_x(text, x)
+    check(not clipped and len(x) == 16 and all(abs(a - b) < 1e-12 for p, q in zip(back, deep) for a, b in zip(p, q)),
+          f"the deep family's x of the profile: {len(x)} variables, no clipping, segments_of_x gives it back")
+    cfg = os.path.join(tmp, "deep.yaml")
+    with open(cfg, "w") as f:
+        f.write(study.set_x0(text, x))
+    res = subprocess.run([abuopt, "optimize", cfg, "--out", os.path.join(tmp, "deep"), "--max-evaluations", "1",
+                          "--threads", "1"], capture_output=True, text=True)
+    best = json.load(open(os.path.join(tmp, "deep", "result.json")))["best"] if res.returncode in (0, 3) else {}
+    got = study.segments_of(best["profile"]) if best else []
+    same = len(got) == len(deep) and all(abs(a - b) <= 1e-5 * b for p, q in zip(got, deep) for a, b in zip(p, q))
+    check(same and best["metrics"]["peak_angular_acceleration_rad_s2"] <= 314.16,
+          f"abuopt evaluates the deep family at that x as the profile (peak "
+          f"{best.get('metrics', {}).get('peak_angular_acceleration_rad_s2')} rad/s^2)")
+
+
 def end_to_end(abuopt, tmp):
     out = os.path.join(tmp, "study")
     cmd = [sys.executable, SCRIPT, "--abuopt", abuopt, "--out", out, "--scale", "0.02", "--val-runs", "8",
@@ -286,6 +368,34 @@ def end_to_end(abuopt, tmp):
           and "## The shipped designs made outside the runner" in study.read(os.path.join(out, "summary.md"))
           and "--mu 0.03" in study.read(os.path.join(out, "validation", "shipped_contact_best_mu03_g6", "config.yaml")),
           f"the shipped 8.13 designs validated as shipped on both seeds ({len(sp)} rows)")
+    # stage 5c: the mean-goal chain from the k4_hold design (six balls, mu 0.02): the up-shake polish, the scan (the
+    # shaken design and every (offset, bottom) that fits its dwell) on the polish's LHS starts, the deep polish; its
+    # design within the bounds, in best/ and validated on both seeds beside the 2003 profile with six balls (paired)
+    mg = s["mean_goal"]
+    scan5c = [x for x in os.listdir(os.path.join(out, "validation")) if x.startswith("mean_goal_")]
+    npoints = 1 + len(study.MEAN_GOAL_OFFSETS_S) * len(study.MEAN_GOAL_BOTTOMS_HZ)
+    made_path = os.path.join(out, "best", "runner_mean_goal_6balls.yaml")
+    made = study.read(made_path) if os.path.exists(made_path) else ""
+    segs5c = study.segments_of(mg["profile"]) if mg else []
+    ends = [0.0] + [f for f, _ in segs5c]
+    # at this scale (5 starts) the chain may end with no point within every bound: then no design, nothing shipped
+    none = not mg and "stage 5c has no design" in r.stdout and not os.path.exists(
+        os.path.join(out, "best", "runner_mean_goal_6balls.yaml")) and "Stage 5c (the mean goal with six balls) found no" \
+        in study.read(os.path.join(out, "summary.md"))
+    check(none and "mean_goal_shaken" in scan5c or mg and {(r["design"], r["seed"]) for r in mg["rows"]} == {("runner_mean_goal_6balls", 9001),
+                                                                     ("runner_mean_goal_6balls", 9002)}
+          and all(r["ok"] == 8 and r["balls"] == 6 and r["mu"] == 0.02 and r["paired"]["n"] == 8 for r in mg["rows"])
+          and len(re.findall(r"^    - \{mass_kg", made, re.M)) == 6 and active_contact_lines(made) == ["hard"]
+          and sum(dt for _, dt in segs5c) <= 19 + 1e-9
+          and max(study.peak_rate(f - e, dt) for (f, dt), e in zip(segs5c, ends)) <= study.MAX_RATE_HZ_S
+          and "(made by the runner, stage 5c)" in study.read(os.path.join(out, "summary.md"))
+          and len(re.findall(r"^    - \{mass_kg", study.read(os.path.join(out, "f1_mu02_shake_6balls", "config.yaml")),
+                             re.M)) == 6
+          and "mean_goal_shaken" in scan5c and npoints - 3 <= len([x for x in scan5c if "Hz_at" in x]) + 1 <= npoints
+          and "# runs 5 seed 21 --mu 0.02 design lhs" in study.read(os.path.join(out, "validation", "mean_goal_shaken",
+                                                                                 "config.yaml")),
+          f"stage 5c: {mg.get('point') if mg else 'no design within the bounds'}, T {sum(dt for _, dt in segs5c):.3f} s, "
+          f"{len(scan5c)} points run, validated on both seeds with six balls (when within the bounds)")
     for fam in ("approach", "oscillate", "release"):
         md = os.path.join(out, f"stop_depth_{fam}", "stop_depth" + ("" if fam == "approach" else "_osc" if fam ==
                                                                        "oscillate" else "_release") + ".md")
@@ -295,7 +405,7 @@ def end_to_end(abuopt, tmp):
           "formulation 2 minimises startup_time with the max_mean_abs_ir bound")
     cost = json.load(open(os.path.join(out, "stage_cost.json")))
     stages = [c["stage"] for c in cost]
-    check(len(stages) == 12 and all(c["cpu_s"] >= 0 and c["wall_s"] >= 0 for c in cost) and cost[0]["cpu_s"] > 0
+    check(len(stages) == 13 and all(c["cpu_s"] >= 0 and c["wall_s"] >= 0 for c in cost) and cost[0]["cpu_s"] > 0
           and "[cost] whole study: CPU" in r.stdout, f"the cost of every stage is recorded: {stages}")
     configs = [os.path.join(d, "config.yaml") for d in
                [os.path.join(out, x) for x in os.listdir(out)] + [os.path.join(out, "validation", x) for x in
