@@ -63,11 +63,25 @@ def setpoint(segs, f_start=0.0, knot=0.01, substeps=100, omega_m=0.7 * math.pi, 
     return out
 
 
+def whole_hz(sp):
+    """the drive's 1 Hz setpoints: whole-Hz samples chosen by first-order error feedback (sigma-delta), so that their
+    running sum follows the setpoint's: the loop (0.35 Hz) averages the +-1 Hz dither; plain rounding leaves up to
+    0.5 Hz offsets in the dwells (docs/pi_feedforward.md)"""
+    err = 0.0
+    out = []
+    for f, d in sp:
+        q = round(f + err)
+        err += f - q
+        out.append((float(q), d))
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument('config', help='a design config made for the ideal motor (profile.segments: end_frequency_hz, duration_s)')
     ap.add_argument('--out', required=True)
     ap.add_argument('--knot', type=float, default=0.01, help='setpoint sample interval in s')
+    ap.add_argument('--whole-hz', action='store_true', help='whole-Hz setpoints for quantize_setpoint_1hz (error feedback)')
     ap.add_argument('--header', default='', help='a file whose text (comment lines) heads the output')
     a = ap.parse_args()
     cfg = yaml.safe_load(open(a.config))
@@ -79,6 +93,8 @@ def main():
     if m.get('setpoint_mismatch') or m.get('quantize_setpoint_1hz'):
         sys.exit('only the plain PI drive (no mismatch, no quantisation) is inverted here')
     sp = setpoint(segs, float(prof.get('start_frequency_hz', 0)), a.knot, **kw)
+    if a.whole_hz:
+        sp = whole_hz(sp)
     text = open(a.header).read() if a.header else ''
     src = open(a.config).read()
     body = src[src.index('\nabu:') + 1:src.index('\nprofile:') + 1]
@@ -87,7 +103,7 @@ def main():
     text += '  start_frequency_hz: %r\n  segments:\n' % float(prof.get('start_frequency_hz', 0))
     for f, d in sp:
         text += '    - {end_frequency_hz: %.6f, duration_s: %.9f}\n' % (f, d)
-    text += 'motor:\n  kind: pi\n'
+    text += 'motor:\n  kind: pi\n' + ('  quantize_setpoint_1hz: true\n' if a.whole_hz else '')
     rest = src[src.index('\nsimulation:') + 1:]
     text += rest
     open(a.out, 'w').write(text)
