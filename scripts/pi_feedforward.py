@@ -1,0 +1,115 @@
+#!/usr/bin/env python3
+"""Feed-forward setpoint for the PI-controlled drive: the setpoint program that makes the drive's REAL speed follow a
+profile designed with the ideal motor. Derivation: docs/pi_feedforward.md.
+
+    python3 scripts/pi_feedforward.py configs/studies/best/contact_best_19s_deep_6balls.yaml \
+        --out configs/studies/best/contact_best_19s_deep_6balls_pi.yaml [--knot 0.01]
+
+The PI loop (docs/model.md section 7), with e = Omega_ref - Omega and delta' = e:
+    Omega' = 2 xi w e + w^2 delta - (T_b/J) sat(Omega/0.1)          (+ the balls' torque, ~1e-3 of it: neglected)
+For a wanted real speed Omega_d(t) = 2 pi f(t) (the ideal design):
+    2 xi w delta' + w^2 delta = Omega_d' + (T_b/J) sat(Omega_d/0.1),  delta(0) = 0
+a stable first-order ODE (pole -w/(2 xi)), integrated by RK4; the setpoint is Omega_ref = Omega_d + delta'. It is
+sampled every --knot s and written as inclined-sine segments between the samples (each flat at its ends: the drive's
+loop, bandwidth 0.35 Hz, smooths the small staircase). The header of the written file is only the how-to; the
+figures belong in it by hand.
+"""
+import argparse
+import math
+import sys
+
+import yaml
+
+
+def ideal_f(segs, f_start, t):
+    """frequency and its derivative of the inclined-sine profile at time t (held after the end)"""
+    f0 = f_start
+    t0 = 0.0
+    for f1, dt in segs:
+        if t <= t0 + dt:
+            h = f1 - f0
+            x = (t - t0) / dt
+            return f0 + h * x - h / (2 * math.pi) * math.sin(2 * math.pi * x), h / dt * (1 - math.cos(2 * math.pi * x))
+        f0 = f1
+        t0 += dt
+    return f0, 0.0
+
+
+def setpoint(segs, f_start=0.0, knot=0.01, substeps=100, omega_m=0.7 * math.pi, xi=0.5, tb=5e-4, j=30e-6):
+    total = sum(d for _, d in segs)
+    n = int(round(total / knot))
+    h = total / n
+    dt = h / substeps
+
+    def ddelta(t, delta):
+        f, fp = ideal_f(segs, f_start, t)
+        wd = 2 * math.pi * f
+        wdp = 2 * math.pi * fp
+        return (wdp + tb / j * max(-1.0, min(1.0, wd / 0.1)) - omega_m ** 2 * delta) / (2 * xi * omega_m)
+
+    t = 0.0
+    delta = 0.0
+    out = []
+    for _ in range(n):
+        for _ in range(substeps):
+            k1 = ddelta(t, delta)
+            k2 = ddelta(t + dt / 2, delta + dt / 2 * k1)
+            k3 = ddelta(t + dt / 2, delta + dt / 2 * k2)
+            k4 = ddelta(t + dt, delta + dt * k3)
+            delta += dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            t += dt
+        f, _ = ideal_f(segs, f_start, t)
+        out.append((f + ddelta(t, delta) / (2 * math.pi), h))
+    return out
+
+
+def whole_hz(sp):
+    """the drive's 1 Hz setpoints: whole-Hz samples chosen by first-order error feedback (sigma-delta), so that their
+    running sum follows the setpoint's: the loop (0.35 Hz) averages the +-1 Hz dither; plain rounding leaves up to
+    0.5 Hz offsets in the dwells (docs/pi_feedforward.md)"""
+    err = 0.0
+    out = []
+    for f, d in sp:
+        q = round(f + err)
+        err += f - q
+        out.append((float(q), d))
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument('config', help='a design config made for the ideal motor (profile.segments: end_frequency_hz, duration_s)')
+    ap.add_argument('--out', required=True)
+    ap.add_argument('--knot', type=float, default=0.01, help='setpoint sample interval in s')
+    ap.add_argument('--whole-hz', action='store_true', help='whole-Hz setpoints for quantize_setpoint_1hz (error feedback)')
+    ap.add_argument('--header', default='', help='a file whose text (comment lines) heads the output')
+    a = ap.parse_args()
+    cfg = yaml.safe_load(open(a.config))
+    prof = cfg['profile']
+    segs = [(float(s['end_frequency_hz']), float(s['duration_s'])) for s in prof['segments']]
+    m = cfg.get('motor', {}) or {}
+    kw = dict(omega_m=float(m.get('omega_m_rad_s', 0.7 * math.pi)), xi=float(m.get('xi', 0.5)),
+              tb=float(m.get('bearing_torque_Nm', 5e-4)), j=float(m.get('inertia_kgm2', 30e-6)))
+    if m.get('setpoint_mismatch') or m.get('quantize_setpoint_1hz'):
+        sys.exit('only the plain PI drive (no mismatch, no quantisation) is inverted here')
+    sp = setpoint(segs, float(prof.get('start_frequency_hz', 0)), a.knot, **kw)
+    if a.whole_hz:
+        sp = whole_hz(sp)
+    text = open(a.header).read() if a.header else ''
+    src = open(a.config).read()
+    body = src[src.index('\nabu:') + 1:src.index('\nprofile:') + 1]
+    text += body
+    text += 'profile:                       # the feed-forward setpoint (scripts/pi_feedforward.py), every %.3f s\n' % (sp[0][1])
+    text += '  start_frequency_hz: %r\n  segments:\n' % float(prof.get('start_frequency_hz', 0))
+    for f, d in sp:
+        text += '    - {end_frequency_hz: %.6f, duration_s: %.9f}\n' % (f, d)
+    text += 'motor:\n  kind: pi\n' + ('  quantize_setpoint_1hz: true\n' if a.whole_hz else '')
+    rest = src[src.index('\nsimulation:') + 1:]
+    text += rest
+    open(a.out, 'w').write(text)
+    print('%d segments, T %.6f s, setpoint %.2f .. %.2f Hz' % (len(sp), sum(d for _, d in sp), min(f for f, _ in sp),
+                                                              max(f for f, _ in sp)))
+
+
+if __name__ == '__main__':
+    main()
