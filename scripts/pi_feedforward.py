@@ -16,6 +16,7 @@ figures belong in it by hand.
 """
 import argparse
 import math
+import re
 import sys
 
 import yaml
@@ -76,6 +77,18 @@ def whole_hz(sp):
     return out
 
 
+def top_level_sections(src):
+    """{name: text} of a config's top-level sections, each from its `name:` line to the next one (comments and blank
+    lines before the first section under ''), in the file's order"""
+    out, name = {}, ''
+    for line in src.splitlines(keepends=True):
+        m = re.match(r'([A-Za-z_][A-Za-z0-9_]*):', line)
+        if m:
+            name = m.group(1)
+        out[name] = out.get(name, '') + line
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument('config', help='a design config made for the ideal motor (profile.segments: end_frequency_hz, duration_s)')
@@ -96,16 +109,14 @@ def main():
     if a.whole_hz:
         sp = whole_hz(sp)
     text = open(a.header).read() if a.header else ''
-    src = open(a.config).read()
-    body = src[src.index('\nabu:') + 1:src.index('\nprofile:') + 1]
-    text += body
+    sections = top_level_sections(open(a.config).read())
+    text += sections.get('abu', '')
     text += 'profile:                       # the feed-forward setpoint (scripts/pi_feedforward.py), every %.3f s\n' % (sp[0][1])
     text += '  start_frequency_hz: %r\n  segments:\n' % float(prof.get('start_frequency_hz', 0))
     for f, d in sp:
         text += '    - {end_frequency_hz: %.6f, duration_s: %.9f}\n' % (f, d)
     text += 'motor:\n  kind: pi\n' + ('  quantize_setpoint_1hz: true\n' if a.whole_hz else '')
-    rest = src[src.index('\nsimulation:') + 1:]
-    text += rest
+    text += ''.join(body for name, body in sections.items() if name not in ('abu', 'profile', 'motor', ''))
     open(a.out, 'w').write(text)
     print('%d segments, T %.6f s, setpoint %.2f .. %.2f Hz' % (len(sp), sum(d for _, d in sp), min(f for f, _ in sp),
                                                               max(f for f, _ in sp)))
