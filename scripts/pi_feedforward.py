@@ -11,8 +11,15 @@ For a wanted real speed Omega_d(t) = 2 pi f(t) (the ideal design):
     2 xi w delta' + w^2 delta = Omega_d' + (T_b/J) sat(Omega_d/0.1),  delta(0) = 0
 a stable first-order ODE (pole -w/(2 xi)), integrated by RK4; the setpoint is Omega_ref = Omega_d + delta'. It is
 sampled every --knot s and written as inclined-sine segments between the samples (each flat at its ends: the drive's
-loop, bandwidth 0.35 Hz, smooths the small staircase). The header of the written file is only the how-to; the
-figures belong in it by hand.
+loop, bandwidth 0.35 Hz, smooths the small staircase). The output is the input's sections (abu, simulation,
+montecarlo, ...) with the new profile and a `kind: pi` motor of the input's drive parameters; --header FILE puts
+FILE's text (the comment lines of a shipped config's header) first, so a shipped config regenerates byte for byte:
+
+    python3 scripts/pi_feedforward.py configs/studies/best/contact_best_19s_deep_6balls.yaml --out X.yaml \
+        --header <(grep '^#' configs/studies/best/contact_best_19s_deep_6balls_pi.yaml)
+
+Refused: an input that is not an ideal-motor design starting from rest, a setpoint outside [0, 1e4] Hz (a design
+too fast for the loop), a --knot outside (0, T].
 """
 import argparse
 import math
@@ -97,17 +104,36 @@ def main():
     ap.add_argument('--whole-hz', action='store_true', help='whole-Hz setpoints for quantize_setpoint_1hz (error feedback)')
     ap.add_argument('--header', default='', help='a file whose text (comment lines) heads the output')
     a = ap.parse_args()
-    cfg = yaml.safe_load(open(a.config))
-    prof = cfg['profile']
+    cfg = yaml.safe_load(open(a.config)) or {}
+    prof = cfg.get('profile') or {}
+    if not prof.get('segments'):
+        sys.exit(f'{a.config}: profile.segments: missing or empty (a design config with an inclined-sine profile)')
     segs = [(float(s['end_frequency_hz']), float(s['duration_s'])) for s in prof['segments']]
+    bad = [i for i, (_, d) in enumerate(segs) if not d > 0]
+    if bad:
+        sys.exit(f'{a.config}: profile.segments[{bad[0]}].duration_s = {segs[bad[0]][1]}: must be > 0')
+    if float(prof.get('start_frequency_hz', 0)) != 0.0:
+        sys.exit(f"{a.config}: profile.start_frequency_hz = {prof['start_frequency_hz']}: must be 0 (the PI drive "
+                 "starts the disc at rest; the inversion assumes it)")
+    total = sum(d for _, d in segs)
+    if not 0 < a.knot <= total:
+        sys.exit(f'--knot {a.knot}: must be in (0, {total:g}] s (the profile\'s duration)')
     m = cfg.get('motor', {}) or {}
-    kw = dict(omega_m=float(m.get('omega_m_rad_s', 0.7 * math.pi)), xi=float(m.get('xi', 0.5)),
-              tb=float(m.get('bearing_torque_Nm', 5e-4)), j=float(m.get('inertia_kgm2', 30e-6)))
+    if m.get('kind', 'ideal') != 'ideal':
+        sys.exit(f"{a.config}: motor.kind = {m.get('kind')}: must be ideal (the design whose speed the drive is to "
+                 "follow; a PI config is already a setpoint)")
     if m.get('setpoint_mismatch') or m.get('quantize_setpoint_1hz'):
         sys.exit('only the plain PI drive (no mismatch, no quantisation) is inverted here')
+    params = {k: m[k] for k in ('omega_m_rad_s', 'xi', 'bearing_torque_Nm', 'inertia_kgm2') if k in m}
+    kw = dict(omega_m=float(params.get('omega_m_rad_s', 0.7 * math.pi)), xi=float(params.get('xi', 0.5)),
+              tb=float(params.get('bearing_torque_Nm', 5e-4)), j=float(params.get('inertia_kgm2', 30e-6)))
     sp = setpoint(segs, float(prof.get('start_frequency_hz', 0)), a.knot, **kw)
     if a.whole_hz:
         sp = whole_hz(sp)
+    lo, hi = min(f for f, _ in sp), max(f for f, _ in sp)
+    if lo < 0 or hi > 1e4:
+        sys.exit(f'the setpoint needs {lo:.3f} .. {hi:.3f} Hz: a profile.segments end_frequency_hz must be in '
+                 '[0, 1e4] Hz (the design asks the drive for more than its loop can be steered to: make it slower)')
     text = open(a.header).read() if a.header else ''
     sections = top_level_sections(open(a.config).read())
     text += sections.get('abu', '')
@@ -115,7 +141,8 @@ def main():
     text += '  start_frequency_hz: %r\n  segments:\n' % float(prof.get('start_frequency_hz', 0))
     for f, d in sp:
         text += '    - {end_frequency_hz: %.6f, duration_s: %.9f}\n' % (f, d)
-    text += 'motor:\n  kind: pi\n' + ('  quantize_setpoint_1hz: true\n' if a.whole_hz else '')
+    text += 'motor:\n  kind: pi\n' + ''.join(f'  {k}: {v}\n' for k, v in params.items())
+    text += '  quantize_setpoint_1hz: true\n' if a.whole_hz else ''
     text += ''.join(body for name, body in sections.items() if name not in ('abu', 'profile', 'motor', ''))
     open(a.out, 'w').write(text)
     print('%d segments, T %.6f s, setpoint %.2f .. %.2f Hz' % (len(sp), sum(d for _, d in sp), min(f for f, _ in sp),
