@@ -239,6 +239,17 @@ void parabola(double, const double* y, double* yd, void*) {
 }
 void parabola_root(double, const double* y, double* g, void*) { g[0] = y[0]; }
 void parabola_rate(double, const double* y, double* gd, void*) { gd[0] = y[1]; }
+
+// Runs st from t = -20 (state y0) to the stop time -0.2 and sets the stop time 1, so that its next
+// step holds both zeros of the parabola (the step size has grown large by then).
+void step_to_before_both_zeros(ErkStepper& st, const double* y0) {
+  st.reset(-20.0, y0);
+  st.set_stop_time(-0.2);
+  ErkStepper::Status s = ErkStepper::Ok;
+  while (s == ErkStepper::Ok) s = st.step();
+  ASSERT_EQ(s, ErkStepper::StopReached);
+  st.set_stop_time(1.0);
+}
 }  // namespace
 
 TEST(ErkStepper, ARootFunctionThatDipsThroughZeroInsideAStepIsFoundWithItsRate) {
@@ -255,13 +266,8 @@ TEST(ErkStepper, ARootFunctionThatDipsThroughZeroInsideAStepIsFoundWithItsRate) 
                   1e-9, 1000);
     st.set_polish_roots(true);
     if (rates) st.set_root_rates(parabola_rate);
-    st.reset(-20.0, y0);
-    st.set_stop_time(-0.2);
-    ErkStepper::Status s = ErkStepper::Ok;
-    while (s == ErkStepper::Ok) s = st.step();
-    ASSERT_EQ(s, ErkStepper::StopReached);
-    st.set_stop_time(1.0);
-    s = st.step();
+    step_to_before_both_zeros(st, y0);
+    const ErkStepper::Status s = st.step();
     if (!rates) {
       EXPECT_EQ(s, ErkStepper::StopReached);  // one step over both crossings: nothing seen
       EXPECT_EQ(st.t(), 1.0);
@@ -305,14 +311,9 @@ TEST(ErkStepper, ASpeedThatReversesAndBackInsideAStepIsStoppedWithItsRateFromThe
                   1000);
     st.set_polish_roots(true);
     if (rates) st.set_dip_rates(stop_rate);
-    st.reset(-20.0, y0);
-    st.set_stop_time(-0.2);
-    ErkStepper::Status s = ErkStepper::Ok;
-    while (s == ErkStepper::Ok) s = st.step();
-    ASSERT_EQ(s, ErkStepper::StopReached);
-    st.set_stop_time(1.0);
+    step_to_before_both_zeros(st, y0);
     const abuopt::SimCounters before = abuopt::sim_counters();
-    s = st.step();
+    const ErkStepper::Status s = st.step();
     if (!rates) {
       EXPECT_EQ(s, ErkStepper::StopReached);  // the missed stop of version 4
       EXPECT_EQ(st.t(), 1.0);
