@@ -344,19 +344,28 @@ def dwells(segments, f0=0.0):
     return [i for i in range(len(segments)) if segments[i][0] == ends[i]]
 
 
+def dwell_at(segments, index, offset_s, f0, what):
+    """(f, dt) of the dwell segments[index] of a profile [(end_frequency_hz, duration_s)] from f0 Hz, into which a
+    `what` ("shake", "excursion") goes offset_s after its start; ValueError if there is no such segment, it is no
+    dwell, or offset_s is not inside it."""
+    if not 0 <= index < len(segments):
+        raise ValueError(f"{what} index {index}: the profile has {len(segments)} segments")
+    f, dt = segments[index]
+    if index not in dwells(segments, f0):
+        raise ValueError(f"segment {index} ({f} Hz, {dt} s) is no dwell: {'an' if what[0] in 'aeiou' else 'a'} "
+                         f"{what} goes into a dwell")
+    if not 0 < offset_s < dt:
+        raise ValueError(f"{what} offset {offset_s} s: must be inside the dwell's (0, {dt}) s")
+    return f, dt
+
+
 def insert_shake(segments, index, offset_s, depth_hz, f0=0.0, max_rate_hz_s=MAX_RATE_HZ_S):
     """A shake inserted into the dwell segments[index] (a profile [(end_frequency_hz, duration_s)] from f0 Hz):
     the dwell at f is split offset_s after its start into (f, offset_s), (f - depth_hz, d), (f, d), (f, rest) with
     d = shake_duration(depth_hz). The profile is unchanged up to the insertion, reaches f - depth_hz at its lowest,
     and after the shake is the old one delayed by 2 d; the total duration grows by 2 d; the shake's peak |f'| is
     max_rate_hz_s / SHAKE_RATE_MARGIN. Pure; ValueError if segments[index] is no dwell or offset_s is not inside it."""
-    if not 0 <= index < len(segments):
-        raise ValueError(f"shake index {index}: the profile has {len(segments)} segments")
-    f, dt = segments[index]
-    if index not in dwells(segments, f0):
-        raise ValueError(f"segment {index} ({f} Hz, {dt} s) is no dwell: a shake goes into a dwell")
-    if not 0 < offset_s < dt:
-        raise ValueError(f"shake offset {offset_s} s: must be inside the dwell's (0, {dt}) s")
+    f, dt = dwell_at(segments, index, offset_s, f0, "shake")
     if depth_hz >= f:
         raise ValueError(f"shake depth {depth_hz} Hz: must be below the dwell's {f} Hz")
     d = shake_duration(depth_hz, max_rate_hz_s)
@@ -687,13 +696,7 @@ def insert_excursion(segments, index, offset_s, to_hz, f0=0.0, max_rate_hz_s=MAX
     [(end_frequency_hz, duration_s)] from f0, the dwell shortened by the excursion's 2 d so the total duration T is
     unchanged: (f, offset_s), (to_hz, d), (f, d), (f, dt - offset_s - 2 d). Pure; ValueError if segments[index] is no
     dwell, offset_s is not in (0, dt), to_hz is f or <= 0, or the dwell has no time left after the excursion."""
-    if not 0 <= index < len(segments):
-        raise ValueError(f"excursion index {index}: the profile has {len(segments)} segments")
-    f, dt = segments[index]
-    if index not in dwells(segments, f0):
-        raise ValueError(f"segment {index} ({f} Hz, {dt} s) is no dwell: an excursion goes into a dwell")
-    if not 0 < offset_s < dt:
-        raise ValueError(f"excursion offset {offset_s} s: must be inside the dwell's (0, {dt}) s")
+    f, dt = dwell_at(segments, index, offset_s, f0, "excursion")
     if to_hz <= 0 or to_hz == f:
         raise ValueError(f"excursion to {to_hz} Hz from a dwell at {f} Hz: must be > 0 and differ")
     d = shake_duration(abs(to_hz - f), max_rate_hz_s)
