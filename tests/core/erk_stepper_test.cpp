@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -240,6 +241,15 @@ void parabola(double, const double* y, double* yd, void*) {
 void parabola_root(double, const double* y, double* g, void*) { g[0] = y[0]; }
 void parabola_rate(double, const double* y, double* gd, void*) { gd[0] = y[1]; }
 
+// The stepper of the parabola tests (7(8) table, rtol 1e-6, atol 1e-9, roots polished), its root
+// function y0: a gap's or a sliding speed's, as the test gives it a rate.
+std::unique_ptr<ErkStepper> parabola_stepper() {
+  auto st = std::make_unique<ErkStepper>(ButcherTable::from_arkode("ARKODE_FEHLBERG_13_7_8"), 2, parabola, parabola_root,
+                                         1, nullptr, 1e-6, 1e-9, 1000);
+  st->set_polish_roots(true);
+  return st;
+}
+
 // Runs st from t = -20 (state y0) to the stop time -0.2 and sets the stop time 1, so that its next
 // step holds both zeros of the parabola (the step size has grown large by then).
 void step_to_before_both_zeros(ErkStepper& st, const double* y0) {
@@ -262,9 +272,8 @@ TEST(ErkStepper, ARootFunctionThatDipsThroughZeroInsideAStepIsFoundWithItsRate) 
   const double y0[2] = {y_at(-20.0), -0.1 - 20.0};
   const double first = 0.1 - std::sqrt(0.008);
   for (bool rates : {false, true}) {
-    ErkStepper st(ButcherTable::from_arkode("ARKODE_FEHLBERG_13_7_8"), 2, parabola, parabola_root, 1, nullptr, 1e-6,
-                  1e-9, 1000);
-    st.set_polish_roots(true);
+    auto stepper = parabola_stepper();
+    ErkStepper& st = *stepper;
     if (rates) st.set_root_rates(parabola_rate);
     step_to_before_both_zeros(st, y0);
     const ErkStepper::Status s = st.step();
@@ -287,11 +296,7 @@ namespace {
 // (v, w = v'), w' = 2 a = 1. The stop function is sigma v (sigma = +1: slipping forward); its rate
 // is sigma v' = the component 0 of the right-hand side, given to the dip check only (a RateFn
 // from dydt, as the simulator's stop functions), so the root is refined without Newton.
-void speed_rhs(double, const double* y, double* yd, void*) {
-  yd[0] = y[1];
-  yd[1] = 1.0;
-}
-void stop_fn(double, const double* y, double* g, void*) { g[0] = y[0]; }
+// The right-hand side and the stop function are the parabola's above (parabola, parabola_root).
 void stop_rate(double, const double*, const double* dydt, double* gd, void*) { gd[0] = dydt[0]; }
 }  // namespace
 
@@ -307,9 +312,8 @@ TEST(ErkStepper, ASpeedThatReversesAndBackInsideAStepIsStoppedWithItsRateFromThe
   const double y0[2] = {v_at(-20.0), -0.1 - 20.0};
   const double t1 = 0.1 - std::sqrt(0.008);
   for (bool rates : {false, true}) {
-    ErkStepper st(ButcherTable::from_arkode("ARKODE_FEHLBERG_13_7_8"), 2, speed_rhs, stop_fn, 1, nullptr, 1e-6, 1e-9,
-                  1000);
-    st.set_polish_roots(true);
+    auto stepper = parabola_stepper();
+    ErkStepper& st = *stepper;
     if (rates) st.set_dip_rates(stop_rate);
     step_to_before_both_zeros(st, y0);
     const abuopt::SimCounters before = abuopt::sim_counters();
@@ -335,9 +339,8 @@ TEST(ErkStepper, ASpeedThatReversesAndBackInsideAStepIsStoppedWithItsRateFromThe
 TEST(ErkStepper, ASpeedThatOnlyApproachesZeroIsNotStopped) {
   auto v_at = [](double t) { return 1e-2 - 0.1 * t + 0.5 * t * t; };  // minimum 5e-3 at t = 0.1
   const double y0[2] = {v_at(-20.0), -0.1 - 20.0};
-  ErkStepper st(ButcherTable::from_arkode("ARKODE_FEHLBERG_13_7_8"), 2, speed_rhs, stop_fn, 1, nullptr, 1e-6, 1e-9,
-                1000);
-  st.set_polish_roots(true);
+  auto stepper = parabola_stepper();
+  ErkStepper& st = *stepper;
   st.set_dip_rates(stop_rate);
   st.reset(-20.0, y0);
   st.set_stop_time(1.0);
