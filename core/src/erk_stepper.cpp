@@ -279,29 +279,47 @@ void ErkStepper::find_dips() {
   const double h = t_ - tprev_;
   for (std::size_t k = 0; k < nroots_; ++k) {
     const double g0 = g0_[k], g1 = g1_[k];
-    if (g0 == 0.0 || g1 == 0.0 || (g0 < 0) != (g1 < 0)) continue;  // no dip: zero or a sign change
-    const double s = g0 < 0 ? -1.0 : 1.0;
+    if (g1 == 0.0) continue;
     // the rate known for k: a gap's (gd_) or one from f (dr_); the two fill disjoint entries
     const double r0 = gd0_[k] + dr0_[k], r1 = gd1_[k] + dr1_[k];
-    if (!(s * r0 < 0 && s * r1 > 0)) continue;  // not towards zero, then away
+    // A function exactly 0 at the start (a cluster released from rest, its stop function; docs/
+    // model.md 11.12) that leaves zero into its positive side (r0 > 0: the side of its mode) and
+    // is back across zero at the end, falling: it crossed zero inside the step. Only r0 > 0: a
+    // start rate the other way is a rounding-level start against the mode, not a crossing.
+    const bool from_zero = g0 == 0.0 && r0 > 0 && g1 < 0 && r1 < 0;
+    // A function on one side at both ends whose rate points towards zero at the start and away at
+    // the end (a dip).
+    const bool dip = g0 != 0.0 && (g0 < 0) == (g1 < 0) && (g0 < 0 ? r0 > 0 && r1 < 0 : r0 < 0 && r1 > 0);
+    if (!from_zero && !dip) continue;
+    const double s = from_zero ? 1.0 : (g0 < 0 ? -1.0 : 1.0);  // the side of the extremum: s * g(t_m) across zero?
     // the interpolant g0 + a1 u + a2 u^2 + a3 u^3 on u in [0, 1]; its slope changes sign once
     const double a1 = h * r0, a2 = 3 * (g1 - g0) - h * (2 * r0 + r1), a3 = 2 * (g0 - g1) + h * (r0 + r1);
+    // a dip's extremum is towards zero from side s (slope -s at the start), a start from zero's
+    // away from it (slope +s)
+    const double sl = from_zero ? 1.0 : -1.0;
     double lo = 0, hi = 1;
     for (int it = 0; it < 60; ++it) {
       const double mid = 0.5 * (lo + hi);
-      if (s * (a1 + mid * (2 * a2 + 3 * a3 * mid)) < 0) lo = mid; else hi = mid;
+      if (sl * s * (a1 + mid * (2 * a2 + 3 * a3 * mid)) > 0) lo = mid; else hi = mid;
     }
     const double u = 0.5 * (lo + hi);
-    if (s * (g0 + u * (a1 + u * (a2 + u * a3))) > 0) continue;  // the interpolant stays on its side
+    const double gu = g0 + u * (a1 + u * (a2 + u * a3));
+    if (dip ? s * gu > 0 : !(gu > 0)) continue;  // a dip that stays on its side; no excursion
     const double tm = tprev_ + u * h;
     if (!(tm > tprev_ && tm < t_)) continue;
-    state_at(tm);  // on the RK solution
+    state_at(tm);  // on the Runge-Kutta solution
     g_(tm, ycache_.data(), gtmp_.data(), user_);
     ++ctr_.root_evaluations;
-    if (s * gtmp_[k] > 0) continue;
+    if (dip ? s * gtmp_[k] > 0 : !(gtmp_[k] > 0)) continue;
     ++ctr_.dips;
-    bt_[k] = tm;
-    bg_[k] = gtmp_[k];
+    if (dip) {
+      bt_[k] = tm;  // [t_prev, t_m] brackets the first crossing
+      bg_[k] = gtmp_[k];
+    } else {
+      // positive on (t_prev, t_m], negative at t: the side the function left zero to stands for
+      // the start of the bracket [t_prev, t], whose inner points are all evaluated on that side
+      g0_[k] = gtmp_[k];
+    }
   }
 }
 

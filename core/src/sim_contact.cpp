@@ -70,12 +70,12 @@ void contact_setup(RunState& rs, const double* y) {
   cs.v_stop = 1e-3 / (rs.params.ball_track_radius_m * rs.omega_n);
 }
 
-void switch_contact_modes(RunState& rs, double W, double Wp, const double* y) {
+void switch_contact_modes(RunState& rs, const ChoiceSpeed& sp, const double* y) {
   ContactState& cs = rs.cs;
   rs.switch_y.assign(y, y + rs.lay().size());
   rs.switch_forced.assign(rs.n, 0);
   rs.switch_closed = cs.closed;
-  choose_contact_modes(rs, W, Wp, rs.switch_y, rs.switch_forced, run_contact_choice(), rs.opt.switch_band);
+  choose_contact_modes(rs, sp, rs.switch_y, rs.switch_forced, run_contact_choice(), rs.opt.switch_band);
   for (std::size_t k = 0; k < cs.geo.pairs(); ++k) {
     if (!rs.switch_closed[k] || cs.closed[k]) continue;
     const double gk = cs.geo.gap(y + rs.lay().beta(0), k);
@@ -181,7 +181,7 @@ int handle_contact_event(RunState& rs, double tbar, std::vector<double>& y, cons
     // Switch model: the clusters and modes at the event's state; a stuck ball does not move
     // (its angle is frozen), so the impact sees it at zero speed, and a cluster at its mean speed.
     const Speed s = rs.pi_motor ? evaluate_forces(rs, tbar, y.data()) : ideal_speed(rs, tbar);
-    switch_contact_modes(rs, s.W, s.Wp, y.data());
+    switch_contact_modes(rs, {s.W, s.Wp}, y.data());
     for (const auto& g : cs.clusters.groups) {
       double v = 0;
       for (std::size_t i : g) v += y[lay.beta_dot(i)];
@@ -261,7 +261,10 @@ int handle_contact_event(RunState& rs, double tbar, std::vector<double>& y, cons
   }
   const Speed sp = rs.pi_motor ? sp0 : ideal_speed(rs, tbar);
   // the switch model chooses with its band (balls chosen stuck get zero speed, as at its impacts)
-  choose_contact_modes(rs, sp.W, sp.Wp, y, forced, run_contact_choice(), sw ? rs.opt.switch_band : 0.0);
+  // (the switch model re-chooses at every right-hand-side call, with that call's W': its choice
+  // takes W' as given; docs/model.md 11.12)
+  choose_contact_modes(rs, sw ? ChoiceSpeed{sp.W, sp.Wp} : choice_speed(rs, tbar, sp), y, forced, run_contact_choice(),
+                       sw ? rs.opt.switch_band : 0.0);
   return impacts;
 }
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -49,8 +50,8 @@ bool touching_speeds(double va, double vb) {
 
 class ModeChoice {
  public:
-  ModeChoice(RunState& rs, double W, double Wp, std::vector<double>& y, const std::vector<char>& forced, double band)
-      : rs_(rs), cs_(rs.cs), lay_(rs.lay()), W_(W), Wp_(Wp), y_(y), forced_(forced), band_(band) {
+  ModeChoice(RunState& rs, const ChoiceSpeed& sp, std::vector<double>& y, const std::vector<char>& forced, double band)
+      : rs_(rs), cs_(rs.cs), lay_(rs.lay()), sp_(sp), y_(y), forced_(forced), band_(band) {
     const std::size_t n = rs.n, K = cs_.geo.pairs();
     pos_of_.assign(n, 0);
     for (std::size_t k = 0; k < K; ++k) pos_of_[cs_.geo.order[k]] = k;
@@ -101,7 +102,16 @@ class ModeChoice {
   }
 
  private:
-  void evaluate() { rs_.model.evaluate_clusters(y_.data(), W_, Wp_, rs_.modes.data(), cs_.clusters, rs_.mu, rs_.forces); }
+  // The forces of the current trial; with the PI drive's friction feedback its W' comes from the
+  // motor equation with the trial's modes (a fixed W' let the choice keep an inconsistent mode:
+  // docs/model.md 11.12).
+  void evaluate() {
+    if (sp_.wp_from_modes) {
+      evaluate_forces(rs_, sp_.tbar, y_.data());
+      return;
+    }
+    rs_.model.evaluate_clusters(y_.data(), sp_.W, sp_.Wp, rs_.modes.data(), cs_.clusters, rs_.mu, rs_.forces);
+  }
   // At rest: zero speed (event-driven), or within the switch model's band |v| <= switch_band
   // (docs/model.md 8.1); with band 0 the test is v == 0.
   bool at_rest(double v) const { return std::fabs(v) <= band_; }
@@ -128,7 +138,7 @@ class ModeChoice {
   RunState& rs_;
   ContactState& cs_;
   const StateLayout& lay_;
-  double W_, Wp_;
+  ChoiceSpeed sp_;
   std::vector<double>& y_;
   const std::vector<char>& forced_;
   double band_;
@@ -427,7 +437,7 @@ ContactChoiceMethod& run_contact_choice() {
   return method;
 }
 
-ContactChoiceResult choose_contact_modes(RunState& rs, double W, double Wp, std::vector<double>& y,
+ContactChoiceResult choose_contact_modes(RunState& rs, const ChoiceSpeed& sp, std::vector<double>& y,
                                          const std::vector<char>& forced, ContactChoiceMethod method, double band) {
   SimCounters& cnt = sim_counters();
   if (method == ContactChoiceMethod::Compare) {
@@ -435,14 +445,17 @@ ContactChoiceResult choose_contact_modes(RunState& rs, double W, double Wp, std:
     RunState ref = rs;
     std::vector<double> yref = y;
     const long choices = cnt.mode_choices;
-    const ContactChoiceResult e = choose_contact_modes(ref, W, Wp, yref, forced, ContactChoiceMethod::Enumerate, band);
+    const ContactChoiceResult e = choose_contact_modes(ref, sp, yref, forced, ContactChoiceMethod::Enumerate, band);
     cnt.mode_choices = choices;
-    const ContactChoiceResult res = choose_contact_modes(rs, W, Wp, y, forced, ContactChoiceMethod::Auto, band);
+    const ContactChoiceResult res = choose_contact_modes(rs, sp, y, forced, ContactChoiceMethod::Auto, band);
     cnt.mode_differs += ref.modes != rs.modes || ref.cs.closed != rs.cs.closed;
     cnt.mode_enum_consistent += e.consistent;
     return res;
   }
-  ModeChoice mc(rs, W, Wp, y, forced, band);
+  // W' from the motor equation reads the motor's states (the switch model's scratch copy holds the
+  // ABU's states only: it takes W' as given)
+  if (sp.wp_from_modes && y.size() < rs.nstate) throw std::logic_error("choose_contact_modes: W' from the modes needs the motor states");
+  ModeChoice mc(rs, sp, y, forced, band);
   ContactChoiceResult res;
   ++cnt.mode_choices;
   if (method != ContactChoiceMethod::Enumerate) {

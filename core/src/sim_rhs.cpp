@@ -56,7 +56,7 @@ void switch_modes(RunState& rs, double tbar, const double* y) {
   // modes is used to choose the new ones.
   const Speed sp = rs.pi_motor ? evaluate_forces(rs, tbar, y) : ideal_speed(rs, tbar);
   if (rs.contact) {
-    switch_contact_modes(rs, sp.W, sp.Wp, y);
+    switch_contact_modes(rs, {sp.W, sp.Wp}, y);
     return;
   }
   rs.model.choose_modes(y, sp.W, sp.Wp, rs.mu, rs.opt.switch_band, rs.modes.data(), rs.forces);

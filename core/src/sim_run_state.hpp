@@ -96,6 +96,20 @@ struct Speed {
   double W = 0, Wp = 0;
 };
 
+// The table speed a mode choice judges its trials with. With the PI drive and its friction
+// feedback, W' depends on the balls' friction and so on the modes being chosen: each trial then
+// takes W' from the motor equation at tbar with its own modes (evaluate_forces; docs/model.md
+// 11.12). Otherwise W and W' are those given; the switch model, which re-chooses at every
+// right-hand-side call, always takes them as given.
+struct ChoiceSpeed {
+  double W = 0, Wp = 0;
+  bool wp_from_modes = false;
+  double tbar = 0;
+};
+inline ChoiceSpeed choice_speed(const RunState& rs, double tbar, const Speed& sp) {
+  return {sp.W, sp.Wp, rs.pi_motor && rs.motor.friction_feedback, tbar};
+}
+
 inline Speed ideal_speed(const RunState& rs, double tbar) {
   const ProfileSample s = rs.profile->sample(tbar / rs.omega_n);
   return {kTwoPi * s.frequency_hz / rs.omega_n, kTwoPi * s.rate_hz_per_s / (rs.omega_n * rs.omega_n)};
@@ -150,13 +164,13 @@ struct ContactChoiceResult {
 ContactChoiceMethod& run_contact_choice();
 // band: clusters with |speed| <= band count as at rest (may stick); 0 for the event-driven
 // model, simulation.switch_band for the switch model (docs/model.md 8.1).
-ContactChoiceResult choose_contact_modes(RunState& rs, double W, double Wp, std::vector<double>& y,
+ContactChoiceResult choose_contact_modes(RunState& rs, const ChoiceSpeed& sp, std::vector<double>& y,
                                          const std::vector<char>& forced,
                                          ContactChoiceMethod method = run_contact_choice(), double band = 0.0);
 // Switch model with contact (docs/model.md 8.1): the clusters and modes of one right-hand-side
 // call, chosen on a copy of y with clusters at |speed| <= switch_band at rest; a contact it cuts
 // gets its gap's root offset (the gap starts at zero).
-void switch_contact_modes(RunState& rs, double W, double Wp, const double* y);
+void switch_contact_modes(RunState& rs, const ChoiceSpeed& sp, const double* y);
 // Applies the roots found at an event: impacts for closing gaps, zero speed for clusters that
 // stopped; then choose_contact_modes. Returns the number of impacts.
 int handle_contact_event(RunState& rs, double tbar, std::vector<double>& y, const std::vector<int>& rinfo);

@@ -204,7 +204,7 @@ void Run::reference_step(double t) {
     if (rs_.modes[i] == BallMode::Stick) y_[lay_.beta_dot(i)] = 0.0;
   const Speed sp = evaluate_forces(rs_, t, y_.data());
   if (rs_.contact)
-    choose_contact_modes(rs_, sp.W, sp.Wp, y_, std::vector<char>(rs_.n, 0));
+    choose_contact_modes(rs_, choice_speed(rs_, t, sp), y_, std::vector<char>(rs_.n, 0));
   else
     rs_.model.choose_modes(y_.data(), sp.W, sp.Wp, rs_.mu, 0.0, rs_.modes.data(), rs_.forces);
   rs_.modes_changed(y_.data());
@@ -230,7 +230,7 @@ void Run::choose_initial_modes() {
     sp.Wp = evaluate_forces(rs_, tiny, yprobe.data()).Wp;
   }
   if (rs_.contact)
-    choose_contact_modes(rs_, sp.W, sp.Wp, yprobe, std::vector<char>(rs_.n, 0));
+    choose_contact_modes(rs_, choice_speed(rs_, tiny, sp), yprobe, std::vector<char>(rs_.n, 0));
   else
     rs_.model.choose_modes(yprobe.data(), sp.W, sp.Wp, rs_.mu, 0.0, rs_.modes.data(), rs_.forces);
   rs_.modes_changed(y_.data());

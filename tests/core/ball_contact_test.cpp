@@ -10,6 +10,8 @@
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/core/abu_model.hpp"
 #include "abuopt/core/sim_counters.hpp"
+#include "abuopt/common/yaml_reader.hpp"
+#include "abuopt/core/simulation_config.hpp"
 #include "abuopt/core/simulator.hpp"
 
 using namespace abuopt;
@@ -253,4 +255,47 @@ TEST(BallContact, ABallStoppedBehindASlowChainIsNotRejoinedAtEveryStop) {
   // in the dip check it is stopped, and every overlap projected during the run is the rounding
   // and the located events' tolerance (kEventGapTol atol = 1e-12 rad), far below 1e-9 rad.
   EXPECT_LT(abuopt::sim_counters().max_gap_correction, 1e-9);
+}
+
+// The three runs of the feed-forward PI + 1 Hz design that ended at the chatter limit (docs/model.md
+// 11.12; contact model version 5, shipped config contact_best_19s_deep_6balls_pi1hz.yaml, mu 0.02:
+// run 893 of seed 9001, runs 50 and 578 of seed 9002, random design, 1024 runs). A whole-Hz setpoint
+// step released a stuck two-ball cluster backward; its stop inside the first step was missed and the
+// choice, with the W' of the modes before the event, kept choosing an inconsistent mode: a 4-event
+// cycle of period 2.1 - 2.4 us until the guard (376, 429 and 423 events). With the trials' W' from
+// the motor equation and the stop found in the first step (version 6) each ends ok and settled, with
+// 179 / 232 / 226 events and |I_r| 0.503 / 1.040 / 1.035e-7 kg m (as each fix alone gave in the
+// scratch builds of 11.12; tolerance 0.05e-7).
+TEST(BallContact, APiSetpointStepThatReleasesAClusterDoesNotChatter) {
+  const std::string cfg =
+      std::string(ABUOPT_SOURCE_DIR) + "/configs/studies/best/contact_best_19s_deep_6balls_pi1hz.yaml";
+  YamlReader root = YamlReader::load_file(cfg);
+  const Simulator sim(read_simulation_setup(root));
+  ASSERT_EQ(sim.setup().motor.kind, MotorKind::PI);
+  ASSERT_TRUE(sim.setup().motor.quantize_setpoint_1hz);
+  struct Case {
+    const char* name;
+    std::vector<double> beta0;
+    double ir;
+  };
+  const Case cases[] = {
+      {"9001 run 893",
+       {3.5587207133390577, 5.2939935814868075, 6.047691991207778, 2.37308259576273, 4.916899452503238, 5.794540682230526},
+       0.503},
+      {"9002 run 50",
+       {5.533638488898895, 0.3234300720683114, 4.351806249634684, 4.041151374312307, 5.991613603648726, 1.0919233021346004},
+       1.040},
+      {"9002 run 578",
+       {3.48479549886498, 5.112149462440565, 6.134051383437081, 0.6347378036173517, 0.21769630883962865, 2.975427097185296},
+       1.035},
+  };
+  for (const Case& c : cases) {
+    RunOverrides o;
+    o.friction_mu = 0.02;
+    const RunOutcome r = sim.run(c.beta0, o);
+    ASSERT_EQ(r.status, RunStatus::Ok) << c.name << ": " << r.message;
+    EXPECT_TRUE(r.settled) << c.name;
+    EXPECT_LT(r.events, 300) << c.name;
+    EXPECT_NEAR(r.residual_imbalance_kgm * 1e7, c.ir, 0.05) << c.name;
+  }
 }

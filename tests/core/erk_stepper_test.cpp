@@ -351,6 +351,65 @@ TEST(ErkStepper, ASpeedThatOnlyApproachesZeroIsNotStopped) {
 }
 
 namespace {
+// A cluster released from rest (docs/model.md 11.12): its stop function v is exactly 0 at the
+// reset, and it starts at the rate r0 into its slip side; the state (v, w = v'), w' = -1, so
+// v(t) = r0 (t - t0) - (t - t0)^2 / 2 reverses and is back at zero at t0 + 2 r0.
+void hill(double, const double* y, double* yd, void*) {
+  yd[0] = y[1];
+  yd[1] = -1.0;
+}
+
+// The hill's stepper with its step size grown (from t = -20 to -0.2), reset at t0 = 0 to (0, r0)
+// with the stop time 1, as the simulator resets at an event and keeps its step size.
+std::unique_ptr<ErkStepper> hill_released(double r0, bool rates) {
+  auto st = std::make_unique<ErkStepper>(ButcherTable::from_arkode("ARKODE_FEHLBERG_13_7_8"), 2, hill, parabola_root, 1,
+                                         nullptr, 1e-6, 1e-9, 1000);
+  st->set_polish_roots(true);
+  if (rates) st->set_dip_rates(stop_rate);
+  const double far[2] = {1e3, 0.0};  // positive until t = -20 + sqrt(2000): no root before -0.2
+  st->reset(-20.0, far);
+  st->set_stop_time(-0.2);
+  ErkStepper::Status s = ErkStepper::Ok;
+  while (s == ErkStepper::Ok) s = st->step();
+  EXPECT_EQ(s, ErkStepper::StopReached);
+  const double released[2] = {0.0, r0};
+  st->reset(0.0, released);
+  st->set_stop_time(1.0);
+  return st;
+}
+}  // namespace
+
+// The first step after a release holds the reversal (r0 = 0.05: v is back at zero at 0.1 and -0.45
+// at the step's end, 1). The stop function is exactly zero at the step's start, so neither the
+// sign-change test nor the dip check of 11.11 sees the stop (contact model version 5, the miss of
+// 11.12); with the check for a function leaving zero into its side (version 6), the extremum of
+// the interpolant (at 0.05, exact: a state component) is confirmed positive on the Runge-Kutta
+// state and the crossing refined by Illinois: at 0.1 within 1e-12, v there within 1e-12 of 0.
+// A function that leaves zero against its side (r0 < 0: the rounding-level start of a cluster
+// released against its acceleration) is not a crossing and gives no event.
+TEST(ErkStepper, AStopInsideTheFirstStepAfterAReleaseFromRestIsFound) {
+  for (bool rates : {false, true}) {
+    auto st = hill_released(0.05, rates);
+    const abuopt::SimCounters before = abuopt::sim_counters();
+    const ErkStepper::Status s = st->step();
+    if (!rates) {
+      EXPECT_EQ(s, ErkStepper::StopReached);  // one step over the reversal: the stop is missed
+      EXPECT_EQ(st->t(), 1.0);
+      EXPECT_NEAR(st->y()[0], -0.45, 1e-12);
+      continue;
+    }
+    ASSERT_EQ(s, ErkStepper::Root);
+    EXPECT_NEAR(st->t(), 0.1, 1e-12);
+    EXPECT_NEAR(st->y()[0], 0.0, 1e-12);
+    EXPECT_EQ(st->roots_found()[0], 1);
+    EXPECT_EQ(abuopt::sim_counters().dips - before.dips, 1);
+  }
+  auto against = hill_released(-0.05, true);
+  EXPECT_EQ(against->step(), ErkStepper::StopReached);
+  EXPECT_EQ(against->t(), 1.0);
+}
+
+namespace {
 // A gap closing on a known trajectory: y = (sin t, cos t); the "gap" g = 0.8 - y0 (a ball at
 // sin t approaching a resting ball at 0.8) closes at t* = asin(0.8), at the rate g' = -y1 = -0.6.
 void closing_gap(double, const double* y, double* g, void*) { g[0] = 0.8 - y[0]; }

@@ -13,7 +13,10 @@ namespace abuopt {
 // pair that separates is joined at an event only if its speeds agree to 1e-9 relative, not 1e-9
 // absolute (the Zeno chatter of slow chains, docs/model.md 11.10); 5: a slipping cluster that
 // reverses and back inside one step is stopped (its stop function's rate from the right-hand side
-// in the dip check, docs/model.md 11.11).
-inline constexpr int kContactModelVersion = 5;
+// in the dip check, docs/model.md 11.11); 6: under the PI drive with friction feedback each trial
+// of the mode choice takes W' from the motor equation with its own modes, and a stop function that
+// leaves zero into its side and is back across zero inside the first step after a release is
+// stopped (the chatter of a setpoint step, docs/model.md 11.12).
+inline constexpr int kContactModelVersion = 6;
 
 }  // namespace abuopt
