@@ -787,7 +787,8 @@ def profile_dict(segs, f0=0.0):
 def mean_goal_chain(st, start, profile, budget):
     """Stage 5c (contact hard: the mu02 configs set it): from `start` (a k4_hold profile: ramp, ramp, dwell, ramp to
     100 Hz) the chain of MEAN_GOAL_*'s comment. budget = ((evaluations, starts) of the shake polish, starts of the
-    scan and the checks, (evaluations, starts) of the deep polish). Returns a design entry."""
+    scan, (evaluations, starts) of the deep polish, (points, starts) of the re-check). Returns a design entry, or None
+    when no point is within every bound on the re-check's starts."""
     mu02 = os.path.join(ROOT, "configs", "studies", "mu02")
     shake_text, deep_text = (read(os.path.join(mu02, n)) for n in ("f1_mu02_shake_polish_6balls.yaml",
                                                                     "f1_mu02_deep_polish_6balls.yaml"))
