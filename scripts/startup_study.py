@@ -687,6 +687,9 @@ def deep_scan(st, family, profile, start, nb):
 # bound). The re-check because the polish's in-sample %MI carries its starts' luck: at 80 x 512 its best, 1.95 % in
 # sample (bound 2), was 2.15 - 2.34 % out of sample (h-run02); and the best few, not the best: neighbours differ by more
 # than their in-sample order says (run03: the polish's 6.60 / 6.61 / 6.62 / 6.86 re-checked 6.45 / 6.38 / 6.56 / 6.77).
+# Not robust to the starts: with the polish / scan LHS seed 21 (the config's) the design is 6.38 / 6.23 / 6.28 out of
+# sample (9001 / 9002 / 9004, %MI <= 0.39 %); the same chain with seed 22 has no design (no deep-polish point within T and
+# %MI at once), with seed 23 its design is 8.97 on the re-check's starts (h-run03's report).
 MEAN_GOAL_MU = 0.02
 MEAN_GOAL_BALLS = 6
 MEAN_GOAL_UP_HZ = 2.2        # f1_mu02_shake_polish_c.yaml's x0: up 2.2 Hz and back, 2.77 s into the dwell
