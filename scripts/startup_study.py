@@ -49,9 +49,11 @@ kept; rerun the same command after an interruption):
      kept) polished with six balls of equal total mass (configs/studies/mu02/f1_mu02_shake_polish_6balls.yaml, COBYLA
      40 x 256 LHS starts), a deep fast down excursion inserted into the result's first dwell (T kept) scanned over
      MEAN_GOAL_OFFSETS_S x MEAN_GOAL_BOTTOMS_HZ on the polish's starts, COBYLA from the scan's best
-     (f1_mu02_deep_polish_6balls.yaml, 40 x 256), its best evaluation within the time, amplitude and %MI bounds slowed
-     onto the acceleration bound (repair_rates) and run again on those starts; the best point within every bound is
-     the design (best/runner_mean_goal_6balls.yaml)
+     (f1_mu02_deep_polish_6balls.yaml, 100 x 256), its best MEAN_GOAL_RECHECK_N evaluations within the time, amplitude
+     and %MI bounds slowed onto the acceleration bound (repair_rates) and, with the scan's best within every bound,
+     re-checked on 1024 LHS starts of another seed (MEAN_GOAL_RECHECK_SEED); the best there within every bound with
+     %MI <= MEAN_GOAL_RECHECK_MI (a margin: the polish chose on its own starts) is the design
+     (best/runner_mean_goal_6balls.yaml)
   6. validation of every best design beside the 2003 profile on 1024 fresh random starts (seed 9001):
      ideal motor, at mu 0.03 and 0.04, PI motor, PI motor with 1 Hz setpoints; switch model on 256;
      every design again on a second fresh set (seed 9002), the formulation-3 designs also at mu 0.03;
@@ -686,8 +688,15 @@ F3_ONE_POLISH = ("f3_robust_k6",)
 # dwell (T kept), scanned over MEAN_GOAL_BOTTOMS_HZ x MEAN_GOAL_OFFSETS_S on the polish's starts (the landscape is
 # rugged: 0.5 Hz of bottom changed the hand scan's result by 3 - 6, so the scan is wide; the hand scan's best was
 # 24 Hz, 0.05 s) -> COBYLA from the scan's best (configs/studies/mu02/f1_mu02_deep_polish_6balls.yaml) -> the best
-# evaluation within the time, amplitude and %MI bounds repaired onto the acceleration bound (repair_rates) and run again
-# on the polish's starts; the best point that meets every bound there is the design (never one over a bound).
+# MEAN_GOAL_RECHECK_N evaluations within the time, amplitude and %MI bounds repaired onto the acceleration bound
+# (repair_rates) and, with the scan's best within every bound, re-checked on other starts (MEAN_GOAL_RECHECK_SEED, 4 x the
+# polish's); the best there that meets every bound with %MI <= MEAN_GOAL_RECHECK_MI is the design (never one over a
+# bound). The re-check because the polish's in-sample %MI carries its starts' luck: at 80 x 512 its best, 1.95 % in
+# sample (bound 2), was 2.15 - 2.34 % out of sample (h-run02); and the best few, not the best: neighbours differ by more
+# than their in-sample order says (run03: the polish's 6.60 / 6.61 / 6.62 / 6.86 re-checked 6.45 / 6.38 / 6.56 / 6.77).
+# Not robust to the starts: with the polish / scan LHS seed 21 (the config's) the design is 6.38 / 6.23 / 6.28 out of
+# sample (9001 / 9002 / 9004, %MI <= 0.39 %); the same chain with seed 22 has no design (no deep-polish point within T and
+# %MI at once), with seed 23 its design is 8.97 on the re-check's starts (h-run03's report).
 MEAN_GOAL_MU = 0.02
 MEAN_GOAL_BALLS = 6
 MEAN_GOAL_UP_HZ = 2.2        # f1_mu02_shake_polish_c.yaml's x0: up 2.2 Hz and back, 2.77 s into the dwell
@@ -695,6 +704,9 @@ MEAN_GOAL_UP_OFFSET_S = 2.77
 MEAN_GOAL_BOTTOMS_HZ = tuple(22.0 + 0.5 * i for i in range(9))  # 22 - 26 Hz every 0.5 Hz
 MEAN_GOAL_OFFSETS_S = (0.05, 0.3, 0.9)
 MEAN_GOAL_MIN_DWELL_S = 0.2  # the families' least dwell (the dwell that gives the time to a repair keeps this much)
+MEAN_GOAL_RECHECK_SEED = 31  # the re-check's LHS starts: neither the polish's (21) nor a validation seed (9001 - 9008)
+MEAN_GOAL_RECHECK_N = 4      # the deep polish's best few re-checked (each a different profile after repair_rates)
+MEAN_GOAL_RECHECK_MI = 1.5   # the re-check's %MI margin under the goal's 2 % (the polish's %MI was chosen on its starts)
 
 
 def insert_excursion(segments, index, offset_s, to_hz, f0=0.0, max_rate_hz_s=MAX_RATE_HZ_S):
@@ -785,11 +797,12 @@ def profile_dict(segs, f0=0.0):
 def mean_goal_chain(st, start, profile, budget):
     """Stage 5c (contact hard: the mu02 configs set it): from `start` (a k4_hold profile: ramp, ramp, dwell, ramp to
     100 Hz) the chain of MEAN_GOAL_*'s comment. budget = ((evaluations, starts) of the shake polish, starts of the
-    scan and the checks, (evaluations, starts) of the deep polish). Returns a design entry."""
+    scan, (evaluations, starts) of the deep polish, (points, starts) of the re-check). Returns a design entry, or None
+    when no point is within every bound on the re-check's starts."""
     mu02 = os.path.join(ROOT, "configs", "studies", "mu02")
     shake_text, deep_text = (read(os.path.join(mu02, n)) for n in ("f1_mu02_shake_polish_6balls.yaml",
                                                                     "f1_mu02_deep_polish_6balls.yaml"))
-    (s_evals, s_runs), scan_runs, (d_evals, d_runs) = budget
+    (s_evals, s_runs), scan_runs, (d_evals, d_runs), (r_count, r_runs) = budget
     t_max, amp_max = section_number(deep_text, "max_startup_time_s"), section_number(deep_text, "max_amplitude_mm")
     mi_max = section_number(deep_text, "max_pct_mi")
     seed = int(section_number(deep_text, "seed"))
@@ -817,13 +830,14 @@ def mean_goal_chain(st, start, profile, budget):
     steps.append({"step": "shake polish", "in_sample": r["best"]["objective"], "feasible": bool(r["best"]["feasible"]),
                   "runs": s_runs})
 
-    def check_point(name, segs_, runs):
-        """Runs segs_ on the polish's starts (LHS, its seed, mu 0.02, six balls); returns (statistics, within bounds)."""
+    def check_point(name, segs_, runs, seed_=seed):
+        """Runs segs_ on `runs` LHS starts of seed_ (default the polish's seed), mu 0.02, six balls; returns (statistics,
+        (within every bound, within T / amplitude / acceleration), T, peak |f'|)."""
         T = sum(dt_ for _, dt_ in segs_)
         ends = [f0] + [f_ for f_, _ in segs_]
         rate = max(peak_rate(segs_[i][0] - ends[i], segs_[i][1]) for i in range(len(segs_)))
         cfg = run_config(profile_dict(segs_, f0), f"stage 5c: {name}", balls=balls, contact="hard")
-        s = st.montecarlo(f"mean_goal_{name}", cfg, runs, seed, ["--mu", f"{MEAN_GOAL_MU:g}"], design="lhs")
+        s = st.montecarlo(f"mean_goal_{name}", cfg, runs, seed_, ["--mu", f"{MEAN_GOAL_MU:g}"], design="lhs")
         hard = T <= t_max + 1e-9 and s["amp_max_mm"] <= amp_max and rate <= MAX_RATE_HZ_S
         return s, (hard and s["ir"]["pct_mi"] <= mi_max, hard), T, rate
 
@@ -857,7 +871,7 @@ def mean_goal_chain(st, start, profile, budget):
     steps.append({"step": "scan", "points": scan, "best": best[0], "best_within": best_all and best_all[0]})
 
     # 3. COBYLA from the scan's best (the deep family needs the excursion; from "shaken" the chain ends here)
-    final = best_all  # None: no point within every bound yet
+    cands, seen = [], set()  # (name, profile, history row or None, segments slowed)
     if best[0] != "shaken":
         base = set_section_value(deep_text, "runs", d_runs)
         x0, clipped = design_x(best[1], base)
@@ -870,31 +884,42 @@ def mean_goal_chain(st, start, profile, budget):
                                                           ("g_startup_time", "g_amplitude", "g_pct_mi"))]
         steps.append({"step": "deep polish", "in_sample": r["best"]["objective"], "feasible": bool(r["best"]["feasible"]),
                       "runs": d_runs})
-        if good:
-            w = min(good, key=lambda w: float(w["objective"]))
+        # 4. the best few within the time, amplitude and %MI bounds in sample, each repaired onto the acceleration bound,
+        # re-checked on more starts of another LHS seed; the design = the best mean there among those within every bound
+        # with a %MI margin (MEAN_GOAL_RECHECK_MI): the polish's own starts chose them, so its %MI carries its luck
+        for w in sorted(good, key=lambda w: float(w["objective"])):
+            if len(cands) >= r_count:
+                break
             x = {c: float(w[c]) for c in names}
             try:
                 segs_r, slowed = repair_rates(segments_of_x(base, x), f0)
-                s, (ok, _), T, rate = check_point("deep_polished_repaired", segs_r, d_runs)
-                st.log(f"[mean goal] deep polish: evaluation {w['evaluation']} ({float(w['objective']):.3f}, "
-                       f"acceleration {float(w['peak_angular_acceleration_rad_s2']):.1f} rad/s^2) repaired "
-                       f"(segments {slowed} slowed): {s['ir']['mean']:.3f} on the polish's {d_runs} starts, amplitude "
-                       f"{s['amp_max_mm']:.4f} mm, T {T:.3f} s{'' if ok else ' (outside the bounds: not kept)'}")
-                steps.append({"step": "repair", "evaluation": int(w["evaluation"]), "slowed": slowed,
-                              "in_sample": s["ir"]["mean"], "within": ok})
-                if ok:
-                    # against the best scan point within every bound on the same starts (the scan's may differ)
-                    ref = None
-                    if best_all:
-                        ref = (check_point(best_all[0], best_all[1], d_runs)[0]["ir"]["mean"] if d_runs != scan_runs
-                               else best_all[2])
-                    if ref is None or s["ir"]["mean"] < ref:
-                        final = ("deep_polished_repaired", segs_r, s["ir"]["mean"])
             except ValueError as e:
-                st.log(f"[mean goal] the deep polish's best could not be repaired ({e}); the scan's best stays")
+                st.log(f"[mean goal] deep polish: evaluation {w['evaluation']} could not be repaired ({e}): skipped")
+                continue
+            key = tuple((round(f_, 6), round(dt_, 6)) for f_, dt_ in segs_r)
+            if key not in seen:
+                seen.add(key)
+                cands.append((f"deep_eval{int(w['evaluation'])}", segs_r, w, slowed))
+    if best_all:  # the best scan point within every bound competes on the same starts
+        cands.append((best_all[0], best_all[1], None, []))
+    final = None
+    for name, segs_r, w, slowed in cands:
+        s, (ok, _), T, rate = check_point(name + "_recheck", segs_r, r_runs, MEAN_GOAL_RECHECK_SEED)
+        ok = ok and s["ir"]["pct_mi"] <= MEAN_GOAL_RECHECK_MI
+        src = (f"evaluation {w['evaluation']} ({float(w['objective']):.3f} in the polish, acceleration "
+               f"{float(w['peak_angular_acceleration_rad_s2']):.1f} rad/s^2, segments {slowed} slowed)" if w else
+               "the scan's best within every bound")
+        st.log(f"[mean goal] re-check of {src}: {s['ir']['mean']:.3f} on {r_runs} LHS starts (seed "
+               f"{MEAN_GOAL_RECHECK_SEED}), %MI {s['ir']['pct_mi']:.2f}, amplitude {s['amp_max_mm']:.4f} mm, "
+               f"T {T:.3f} s{'' if ok else ' (outside the bounds or the %MI margin: not kept)'}")
+        steps.append({"step": "re-check", "point": name, "evaluation": int(w["evaluation"]) if w else None,
+                      "slowed": slowed, "in_sample": s["ir"]["mean"], "pct_mi": s["ir"]["pct_mi"],
+                      "amp_max_mm": s["amp_max_mm"], "runs": r_runs, "within": ok})
+        if ok and (final is None or s["ir"]["mean"] < final[2]):
+            final = (name, segs_r, s["ir"]["mean"])
     if final is None:  # never a design over a bound: the stage has none (stage 6 validates nothing)
-        st.log("[mean goal] no point within every bound (time, amplitude, acceleration, %MI on the polish's starts): "
-               "stage 5c has no design")
+        st.log(f"[mean goal] no point within every bound (time, amplitude, acceleration, %MI <= {MEAN_GOAL_RECHECK_MI:g} "
+               f"on the re-check's starts): stage 5c has no design")
         return None
     segs = final[1]
     T = sum(dt_ for _, dt_ in segs)
@@ -983,12 +1008,14 @@ def main():
     shake_budget = ((max(2, int(80 * sc)), max(4, int(512 * sc))), (max(2, int(80 * sc)), max(4, int(512 * sc))),
                     (max(2, int(60 * sc)), max(4, int(256 * sc))))
     # Stage 5c, the mean-goal chain (contact hard only): (evaluations, starts) of the six-ball shake polish, the starts of
-    # the deep scan (28 points) and of the checks, (evaluations, starts) of the deep polish. A six-ball run of these 19 s
-    # profiles at mu 0.02 costs about 5 - 7 ms: about 28 000 runs, measured 175 s of CPU at scale 1 (docs/studies/
-    # startup-profile.md 8.13 "Made by the runner"), its validation (2 x 1024 runs; the 2003 six-ball reference is the
+    # the deep scan (28 points) and of the check, (evaluations, starts) of the deep polish, (points, starts) of the
+    # re-check. A six-ball run of these 19 s profiles at mu 0.02 costs about 5 - 7 ms: about 48 000 runs, measured 280 s of
+    # CPU at scale 1 on a loaded machine (247 s to the deep polish's end, 33 s the re-check; h-run03's report). 100 deep
+    # evaluations, not 40: from the runner's k4_hold design COBYLA found its best basin at evaluation 45 (8.26 at 40,
+    # 6.60 at 45 in sample) and still improved to 87. Its validation (2 x 1024 runs; the 2003 six-ball reference is the
     # shipped deep design's) about 12 s more.
     mean_budget = ((max(2, int(40 * sc)), max(4, int(256 * sc))), max(4, int(256 * sc)),
-                   (max(2, int(40 * sc)), max(4, int(256 * sc))))
+                   (max(2, int(100 * sc)), max(4, int(256 * sc))), (MEAN_GOAL_RECHECK_N, max(4, int(1024 * sc))))
     mean_goal = contact == "hard"
     counts = [] if a.skip_balls else list(range(2, 7))
     n_designs = len(FAMILIES) + 1 + len(FRONT_T) + 1 + 1 + 1 + 1 + 1 + 1
@@ -1007,7 +1034,8 @@ def main():
                      + (len(DEEP_BOTTOMS_HZ) + 1) * shake_budget[0][1]  # 4c's deep scan
                      + (4 * len(SHIPPED) if contact == "hard" else 0) * val_runs  # the shipped designs and their 2003
                      + ((1 + len(MEAN_GOAL_OFFSETS_S) * len(MEAN_GOAL_BOTTOMS_HZ)) * mean_budget[1]
-                        + 2 * mean_budget[2][1] + 2 * val_runs if mean_goal else 0))  # 5c's scan, checks, validation
+                        + (mean_budget[3][0] + 1) * mean_budget[3][1] + 2 * val_runs if mean_goal else 0))  # 5c
+
     st.log(f"startup study, ball contact {contact}: {n_designs} designs, about {st.evals_total} evaluations and "
            f"{st.runs_total} validation runs; output {st.out}")
 
@@ -1249,7 +1277,8 @@ def main():
     if mean_goal_design:  # ready to run as the shipped designs are (its balls, contact, mu 0.02)
         g = mean_goal_design
         text = run_config(g["result"]["best"]["profile"], f"startup study design runner_mean_goal_6balls (stage 5c: "
-                          f"{g['point']}, in sample {g['result']['best']['objective']:.3f}), {g['balls']} balls of equal "
+                          f"{g['point']}, in sample {g['result']['best']['objective']:.3f} on the re-check's LHS starts, seed "
+                          f"{MEAN_GOAL_RECHECK_SEED}), {g['balls']} balls of equal "
                           "total mass, ball contact hard", balls=equal_mass_balls(g["balls"]), contact="hard")
         with open(os.path.join(best_dir, "runner_mean_goal_6balls.yaml"), "w") as f:
             f.write(text)

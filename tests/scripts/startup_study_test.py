@@ -391,11 +391,19 @@ def end_to_end(abuopt, tmp):
           and "(made by the runner, stage 5c)" in study.read(os.path.join(out, "summary.md"))
           and len(re.findall(r"^    - \{mass_kg", study.read(os.path.join(out, "f1_mu02_shake_6balls", "config.yaml")),
                              re.M)) == 6
-          and "mean_goal_shaken" in scan5c and npoints - 3 <= len([x for x in scan5c if "Hz_at" in x]) + 1 <= npoints
+          and "mean_goal_shaken" in scan5c and npoints - 3 <= len([x for x in scan5c if "Hz_at" in x and "recheck" not in x]) + 1 <= npoints
           and "# runs 5 seed 21 --mu 0.02 design lhs" in study.read(os.path.join(out, "validation", "mean_goal_shaken",
                                                                                  "config.yaml")),
           f"stage 5c: {mg.get('point') if mg else 'no design within the bounds'}, T {sum(dt for _, dt in segs5c):.3f} s, "
           f"{len(scan5c)} points run, validated on both seeds with six balls (when within the bounds)")
+    # its design = the best of the re-check (LHS starts of MEAN_GOAL_RECHECK_SEED) within every bound with the %MI margin
+    rc = [x for x in mg["steps"] if x["step"] == "re-check"] if mg else []
+    check(not mg or rc and any(x["point"] == mg["point"] and x["within"] and x["pct_mi"] <= study.MEAN_GOAL_RECHECK_MI
+                               for x in rc)
+          and abs(mg["in_sample"] - min(x["in_sample"] for x in rc if x["within"])) < 1e-12
+          and all(f"seed {study.MEAN_GOAL_RECHECK_SEED} --mu 0.02 design lhs" in study.read(
+              os.path.join(out, "validation", f"mean_goal_{x['point']}_recheck", "config.yaml")) for x in rc),
+          f"stage 5c's re-check: {len(rc)} points, the design the best within the bounds and the %MI margin there")
     for fam in ("approach", "oscillate", "release"):
         md = os.path.join(out, f"stop_depth_{fam}", "stop_depth" + ("" if fam == "approach" else "_osc" if fam ==
                                                                        "oscillate" else "_release") + ".md")
