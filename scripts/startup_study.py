@@ -1018,13 +1018,13 @@ def main():
                    (max(2, int(100 * sc)), max(4, int(256 * sc))), (MEAN_GOAL_RECHECK_N, max(4, int(1024 * sc))))
     mean_goal = contact == "hard"
     counts = [] if a.skip_balls else list(range(2, 7))
+    # Formulation 3's aimed objectives: two polishes each, the spread objective (f3_robust_k6) one (F3_ONE_POLISH)
+    f3_polishes = {name: 1 if name in F3_ONE_POLISH else 2 for name in f3_budget}
     n_designs = len(FAMILIES) + 1 + len(FRONT_T) + 1 + 1 + 1 + 1 + 1 + 1
     st.evals_total = (len(FAMILIES) * (g_evals + p_evals) + p_evals + len(FRONT_T) * front_evals + 1 +
                       (f2_starts + f2p_starts_n) * f2_evals + 1 + robust_evals + 2 * len(counts) * p_evals + q_evals
                       + sum(g + f3_polishes[n] * p for n, (g, _, p, _) in f3_budget.items()) + f2q_budget[0]
                       + 4 * f2q_budget[2] + 2)
-    # Formulation 3's aimed objectives: two polishes each, the spread objective (f3_robust_k6) one (F3_ONE_POLISH)
-    f3_polishes = {name: 1 if name in F3_ONE_POLISH else 2 for name in f3_budget}
     n_designs += sum(f3_polishes.values()) + len(shake_budget) + 1  # 4c's three designs and its deep step
     st.evals_total += sum(e for e, _ in shake_budget) + (mean_budget[0][0] + mean_budget[2][0] if mean_goal else 0)
     st.runs_total = ((n_designs + 1) * val_runs * 4 + 7 * (val_runs * 2 + (switch_runs * 2 if contact == "none" else 0))
