@@ -239,35 +239,45 @@ EvaluationArchive::EvaluationArchive(const std::string& path, std::string proble
                         "are recomputed)");
     exec("PRAGMA journal_mode=WAL");
     exec("PRAGMA synchronous=NORMAL");
-    exec(
-        "CREATE TABLE IF NOT EXISTS evaluations ("
-        " id INTEGER PRIMARY KEY AUTOINCREMENT,"
-        " problem_id TEXT NOT NULL,"
-        " x_key TEXT NOT NULL,"        // hex of the bits of x (exact)
-        " runs INTEGER NOT NULL,"      // Monte Carlo runs of the value (0: not a sampled problem)
-        " x TEXT NOT NULL,"            // JSON array (readable)
-        " objective REAL,"             // readable; NULL for NaN
-        " values_hex TEXT NOT NULL,"   // hex of objective, g..., h... (exact)
-        " n_inequality INTEGER NOT NULL,"
-        " inequality TEXT NOT NULL,"   // JSON (readable)
-        " equality TEXT NOT NULL,"     // JSON (readable)
-        " metrics TEXT NOT NULL,"      // JSON object
-        " ok INTEGER NOT NULL,"
-        " message TEXT NOT NULL,"
-        " wall_time_s REAL,"
-        " timestamp TEXT NOT NULL,"
-        " checksum TEXT NOT NULL,"     // row_checksum() of the fields read back
-        " UNIQUE(problem_id, x_key, runs))");
-    exec(
-        "CREATE TABLE IF NOT EXISTS problems ("
-        " problem_id TEXT PRIMARY KEY, name TEXT, variables TEXT, inequality TEXT, equality TEXT,"
-        " created TEXT)");
-    exec(
-        "CREATE TABLE IF NOT EXISTS metadata ("
-        " id INTEGER PRIMARY KEY AUTOINCREMENT, problem_id TEXT NOT NULL, timestamp TEXT NOT NULL,"
-        " abuopt_version TEXT NOT NULL, git_commit TEXT NOT NULL, command TEXT NOT NULL, config TEXT NOT NULL,"
-        " config_hash TEXT NOT NULL)");
-    if (!existing) exec(("PRAGMA user_version = " + std::to_string(kSchemaVersion)).c_str());
+    // The schema (three tables and the version) in one transaction: a process killed while it
+    // creates the archive leaves no schema or all of it, never tables without their version
+    // (which the check above would refuse on resume).
+    exec("BEGIN IMMEDIATE");
+    try {
+      exec(
+          "CREATE TABLE IF NOT EXISTS evaluations ("
+          " id INTEGER PRIMARY KEY AUTOINCREMENT,"
+          " problem_id TEXT NOT NULL,"
+          " x_key TEXT NOT NULL,"        // hex of the bits of x (exact)
+          " runs INTEGER NOT NULL,"      // Monte Carlo runs of the value (0: not a sampled problem)
+          " x TEXT NOT NULL,"            // JSON array (readable)
+          " objective REAL,"             // readable; NULL for NaN
+          " values_hex TEXT NOT NULL,"   // hex of objective, g..., h... (exact)
+          " n_inequality INTEGER NOT NULL,"
+          " inequality TEXT NOT NULL,"   // JSON (readable)
+          " equality TEXT NOT NULL,"     // JSON (readable)
+          " metrics TEXT NOT NULL,"      // JSON object
+          " ok INTEGER NOT NULL,"
+          " message TEXT NOT NULL,"
+          " wall_time_s REAL,"
+          " timestamp TEXT NOT NULL,"
+          " checksum TEXT NOT NULL,"     // row_checksum() of the fields read back
+          " UNIQUE(problem_id, x_key, runs))");
+      exec(
+          "CREATE TABLE IF NOT EXISTS problems ("
+          " problem_id TEXT PRIMARY KEY, name TEXT, variables TEXT, inequality TEXT, equality TEXT,"
+          " created TEXT)");
+      exec(
+          "CREATE TABLE IF NOT EXISTS metadata ("
+          " id INTEGER PRIMARY KEY AUTOINCREMENT, problem_id TEXT NOT NULL, timestamp TEXT NOT NULL,"
+          " abuopt_version TEXT NOT NULL, git_commit TEXT NOT NULL, command TEXT NOT NULL, config TEXT NOT NULL,"
+          " config_hash TEXT NOT NULL)");
+      if (!existing) exec(("PRAGMA user_version = " + std::to_string(kSchemaVersion)).c_str());
+      exec("COMMIT");
+    } catch (...) {
+      sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+      throw;
+    }
   } catch (const ConfigError&) {
     sqlite3_close(db_);
     db_ = nullptr;
