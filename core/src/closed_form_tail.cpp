@@ -1,6 +1,7 @@
 // The closed-form tail of a run (see docs/model.md section 6).
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <complex>
 
@@ -104,6 +105,161 @@ bool closed_form_tail(RunState& rs, double tbar, std::vector<double>& y, double 
   }
   const Eigen::Vector4d zend = state_at(tbar_end - tbar);
   for (int k = 0; k < 4; ++k) y[k] = zend[k];
+  return true;
+}
+
+// Closed-form tail under the PI drive (docs/model.md 6.1). Profile over: the reference W_ref is
+// constant. Every ball stuck: the balls' angles are constants and the state that still moves is
+// q = (x, y, x', y', delta, W). Its equilibrium q_s (z_s of the ideal tail at W_ref, delta_s from
+// W' = 0, polished by one Newton step on the full right-hand side) and the linearisation
+// q' = A (q - q_s) are taken from the simulator's own right-hand side and root functions by central
+// differences (the right-hand side is at most quadratic in q: exact up to rounding). The bound on
+// every root function is that of the ideal tail with A 6 x 6. The neglected terms are second order
+// in the deviation; they are kept small relative to the first-order ones by two conditions:
+// |W - W_ref| <= 1e-3 W_ref, and the bound may use at most half of every margin (the other half is
+// the reserve for them). Not a proof: checked against integration (tests/core/closed_form_tail_pi_test.cpp).
+bool closed_form_tail_pi(RunState& rs, double tbar, std::vector<double>& y, double tbar_end, double& peak_amp,
+                         void (*roots)(double, const double*, double*, void*)) {
+  if (!rs.pi_motor) return false;
+  const StateLayout& lay = rs.lay();
+  const std::size_t id = lay.motor_delta(), iw = lay.motor_speed();
+  const double W_ref = kTwoPi * reference_hz(rs, tbar) / rs.omega_n;
+  const double bb = rs.nd.bbar;
+  if (!(bb > 0) || !(W_ref * rs.omega_n > 1.0)) return false;  // the bearing torque's regularisation: far away
+  if (!(std::fabs(y[iw] - W_ref) <= 1e-3 * W_ref)) return false;
+  for (std::size_t i = 0; i < rs.n; ++i)
+    if (rs.modes[i] != BallMode::Stick || y[lay.beta_dot(i)] != 0.0) return false;
+  const std::array<std::size_t, 6> idx = {0, 1, 2, 3, id, iw};
+
+  // The equilibrium: the table's static balance at W_ref (as the ideal tail), delta from W' = 0.
+  std::vector<double> ys(y);
+  {
+    const double W = W_ref;
+    double Cx = rs.nd.mbar_I * rs.nd.ebar, Cy = 0;
+    for (std::size_t i = 0; i < rs.n; ++i) {
+      Cx += rs.nd.mbar[i] * std::cos(y[lay.beta(i)]);
+      Cy += rs.nd.mbar[i] * std::sin(y[lay.beta(i)]);
+    }
+    Cx *= W * W;
+    Cy *= W * W;
+    const double a11 = 1 - W * W, a12 = -2 * bb * W, a21 = 2 * bb * W, a22 = 1 - W * W;
+    const double det = a11 * a22 - a12 * a21;
+    ys[0] = (Cx * a22 - a12 * Cy) / det;
+    ys[1] = (a11 * Cy - Cx * a21) / det;
+    ys[2] = ys[3] = 0;
+    ys[iw] = W_ref;
+    ys[id] = 0;
+    rs.eval(ys.data(), W_ref, 0.0);
+    double torque = 0;
+    if (rs.motor.friction_feedback) {
+      const double L = rs.params.ball_track_radius_m, w2 = rs.omega_n * rs.omega_n;
+      for (std::size_t i = 0; i < rs.n; ++i) torque += rs.forces.fw[i] * rs.params.balls[i].mass_kg * w2 * L * L;
+    }
+    const double load = -rs.motor.bearing_torque_Nm * std::clamp(W_ref * rs.omega_n / 0.1, -1.0, 1.0);
+    const double wm = rs.motor.omega_m_rad_s;
+    ys[id] = -(load + torque) / (rs.motor.inertia_kgm2 * wm * wm);
+  }
+  const std::size_t nv = lay.size() + 2;
+  std::vector<double> f(nv), fp(nv), fm(nv), q(ys);
+  auto rhs6 = [&](const std::vector<double>& state, Eigen::Matrix<double, 6, 1>& out) {
+    rhs_plain(tbar, state.data(), f.data(), &rs);
+    for (int k = 0; k < 6; ++k) out[k] = f[idx[k]];
+  };
+  auto steps = [&](const std::vector<double>& at) {
+    std::array<double, 6> h{};
+    const double zn = std::max(std::hypot(at[0], at[1]), 1e-12);
+    for (int k = 0; k < 4; ++k) h[k] = 1e-4 * zn;
+    h[4] = 1e-6 * std::max(1.0, std::fabs(at[id]));
+    h[5] = 1e-6 * std::max(1.0, std::fabs(at[iw]));
+    return h;
+  };
+  auto jacobian = [&](const std::vector<double>& at, Eigen::Matrix<double, 6, 6>& A) {
+    const auto h = steps(at);
+    Eigen::Matrix<double, 6, 1> up, dn;
+    for (int k = 0; k < 6; ++k) {
+      q = at;
+      q[idx[k]] += h[k];
+      rhs6(q, up);
+      q = at;
+      q[idx[k]] -= h[k];
+      rhs6(q, dn);
+      A.col(k) = (up - dn) / (2 * h[k]);
+    }
+  };
+  // One Newton step on the full right-hand side (the fixed point of the friction feedback and the
+  // regularisations are in it), then the residual must be at rounding level.
+  Eigen::Matrix<double, 6, 6> A;
+  Eigen::Matrix<double, 6, 1> r;
+  jacobian(ys, A);
+  rhs6(ys, r);
+  const Eigen::Matrix<double, 6, 1> dq = A.partialPivLu().solve(r);
+  for (int k = 0; k < 6; ++k) ys[idx[k]] -= dq[k];
+  jacobian(ys, A);
+  rhs6(ys, r);
+  const double scale = W_ref * W_ref * (std::hypot(ys[0], ys[1]) + rs.nd.mbar_I * rs.nd.ebar);
+  if (!(r.template head<4>().norm() <= 1e-9 * scale && std::fabs(r[4]) <= 1e-9 * W_ref &&
+        std::fabs(r[5]) <= 1e-9 * W_ref))
+    return false;
+
+  Eigen::EigenSolver<Eigen::Matrix<double, 6, 6>> es(A);
+  if (es.info() != Eigen::Success) return false;
+  const Eigen::Matrix<std::complex<double>, 6, 6> V = es.eigenvectors();
+  const Eigen::Matrix<std::complex<double>, 6, 1> lam = es.eigenvalues();
+  for (int k = 0; k < 6; ++k)
+    if (!(lam[k].real() < 0)) return false;
+  Eigen::Matrix<double, 6, 1> e0;
+  for (int k = 0; k < 6; ++k) e0[k] = y[idx[k]] - ys[idx[k]];
+  const Eigen::Matrix<std::complex<double>, 6, 1> c = V.partialPivLu().solve(e0.cast<std::complex<double>>());
+  if (!c.allFinite()) return false;
+
+  // The root functions at q_s and their gradients.
+  const std::size_t nr = rs.nroots();
+  std::vector<double> gs(nr), gu(nr), gd(nr);
+  roots(tbar, ys.data(), gs.data(), &rs);
+  Eigen::MatrixXd G(static_cast<Eigen::Index>(nr), 6);
+  const auto h = steps(ys);
+  for (int k = 0; k < 6; ++k) {
+    q = ys;
+    q[idx[k]] += h[k];
+    roots(tbar, q.data(), gu.data(), &rs);
+    q = ys;
+    q[idx[k]] -= h[k];
+    roots(tbar, q.data(), gd.data(), &rs);
+    for (std::size_t j = 0; j < nr; ++j) G(static_cast<Eigen::Index>(j), k) = (gu[j] - gd[j]) / (2 * h[k]);
+  }
+  for (std::size_t j = 0; j < nr; ++j) {
+    double bound = 0;
+    for (int k = 0; k < 6; ++k)
+      bound += std::abs(G.row(static_cast<Eigen::Index>(j)).cast<std::complex<double>>().dot(V.col(k))) * std::abs(c[k]);
+    if (!(gs[j] > 0 && bound <= 0.5 * gs[j])) return false;
+  }
+
+  // Accepted: the amplitude peak of the tail (sampled as the ideal tail does), the final state.
+  auto state_at = [&](double dt) {
+    Eigen::Matrix<std::complex<double>, 6, 1> ex;
+    for (int k = 0; k < 6; ++k) ex[k] = c[k] * std::exp(lam[k] * dt);
+    Eigen::Matrix<double, 6, 1> out = (V * ex).real();
+    for (int k = 0; k < 6; ++k) out[k] += ys[idx[k]];
+    return out;
+  };
+  double transient = 0;
+  for (int k = 0; k < 6; ++k) transient += std::hypot(std::abs(V(0, k)), std::abs(V(1, k))) * std::abs(c[k]);
+  const double L_mm = rs.params.ball_track_radius_m * 1e3;
+  if ((std::hypot(ys[0], ys[1]) + transient) * L_mm > peak_amp) {
+    double slowest = 0, fastest = 0;
+    for (int k = 0; k < 6; ++k) {
+      slowest = std::max(slowest, -1.0 / lam[k].real());
+      fastest = std::max(fastest, std::abs(lam[k].imag()));
+    }
+    const double span = std::min(tbar_end - tbar, 20.0 * slowest);
+    const double dt = fastest > 0 ? std::min(0.05 / fastest * kTwoPi, span / 16) : span / 16;
+    for (double s = 0; s <= span; s += std::max(dt, 1e-9)) {
+      const auto z = state_at(s);
+      peak_amp = std::max(peak_amp, std::hypot(z[0], z[1]) * L_mm);
+    }
+  }
+  const auto qend = state_at(tbar_end - tbar);
+  for (int k = 0; k < 6; ++k) y[idx[k]] = qend[k];
   return true;
 }
 

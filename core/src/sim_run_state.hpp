@@ -177,5 +177,10 @@ int handle_contact_event(RunState& rs, double tbar, std::vector<double>& y, cons
 // After the profile, with every ball stuck and an ideal motor: finishes the run in closed form
 // when a bound proves no ball can slip again (closed_form_tail.cpp).
 bool closed_form_tail(RunState& rs, double tbar, std::vector<double>& y, double tbar_end, double& peak_amp);
+// The same under the PI drive: the linearisation of table and motor about their equilibrium at the
+// constant reference, the run's own root functions `roots` bounded with a reserve of half of every
+// margin for the neglected second-order terms (closed_form_tail.cpp, docs/model.md 6.1).
+bool closed_form_tail_pi(RunState& rs, double tbar, std::vector<double>& y, double tbar_end, double& peak_amp,
+                         void (*roots)(double, const double*, double*, void*));
 
 }  // namespace abuopt::detail

@@ -12,7 +12,9 @@
 // root the modes of all balls are chosen together (AbuModel::choose_modes) and the integrator is
 // reset. After the profile ends with every ball stuck (ideal motor), the table motion is linear
 // and time-invariant; if a bound on its transient proves that no stick margin can reach zero, the
-// run is finished in closed form (closed_form_tail). While every ball is stuck (ideal motor), the
+// run is finished in closed form (closed_form_tail). Under the PI drive the same with table and
+// motor linearised about their equilibrium and a reserve for the neglected terms
+// (closed_form_tail_pi, docs/model.md 6.1). While every ball is stuck (ideal motor), the
 // default stuck integrator propagates the table exactly instead of stepping
 // (stuck_propagator.hpp, docs/stuck_propagator.md); the stepper restarts at the next event.
 //
@@ -353,7 +355,7 @@ RunOutcome Run::execute() {
     next_traj = traj_dt_;
   }
 
-  const bool tail_enabled = event_driven_ && rs_.opt.closed_form_tail && !rs_.pi_motor && !tracing;
+  const bool tail_enabled = event_driven_ && rs_.opt.closed_form_tail && !tracing;
   bool integ_stale = false;  // the exact propagator moved (t, y): the stepper restarts from there
   while (t < t_end_) {
     Integrator::Result res = Integrator::Ok;
@@ -413,7 +415,10 @@ RunOutcome Run::execute() {
     if (t >= t_end_) break;
 
     if (tail_enabled && t >= t_profile_ && t >= next_tail_check && all_stuck_since_ >= 0) {
-      if (closed_form_tail(rs_, t, y, t_end_, peak_amp_)) {
+      const bool done = rs_.pi_motor
+                            ? closed_form_tail_pi(rs_, t, y, t_end_, peak_amp_, rs_.contact ? roots_contact : roots_plain)
+                            : closed_form_tail(rs_, t, y, t_end_, peak_amp_);
+      if (done) {
         t = t_end_;
         break;
       }
