@@ -95,6 +95,27 @@ BENCHMARK(BM_FinalProfileRun_Native)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FinalProfileRun_Arkode)->Args({6, 0})->Unit(benchmark::kMillisecond)->Iterations(32);
 
+// The report's final profile under the PI drive (friction feedback on), with and without the
+// closed-form tail after the profile (docs/model.md 6.1). Args: tail (0/1), 1 Hz setpoints (0/1),
+// balls (2: the report's; 6: equal total mass in hard contact, the study's mean-goal ABU).
+void BM_PiDriveRun(benchmark::State& state) {
+  abuopt::SimulationSetup s = final_profile(abuopt::IntegratorBackend::Native, 1e-6, abuopt::StuckIntegrator::Exact);
+  s.motor.kind = abuopt::MotorKind::PI;
+  s.options.closed_form_tail = state.range(0) != 0;
+  s.motor.quantize_setpoint_1hz = state.range(1) != 0;
+  if (state.range(2) == 6) {
+    s.abu.balls.assign(6, abuopt::Ball{2.8e-4 / 6, 3.0e-3 * std::cbrt(2.0 / 6)});
+    s.abu.ball_contact = abuopt::BallContact::Hard;
+  }
+  abuopt::Simulator sim(s);
+  run_cycle(state, sim);
+}
+BENCHMARK(BM_PiDriveRun)
+    ->ArgsProduct({{0, 1}, {0, 1}, {2, 6}})
+    ->ArgNames({"tail", "pi1hz", "balls"})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(32);
+
 // Cost against the tolerance (-log10 rtol 4..10), both stuck integrators.
 void BM_Tolerance(benchmark::State& state) { run_profile(state, abuopt::IntegratorBackend::Native); }
 BENCHMARK(BM_Tolerance)
