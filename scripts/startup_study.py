@@ -707,6 +707,7 @@ MEAN_GOAL_MIN_DWELL_S = 0.2  # the families' least dwell (the dwell that gives t
 MEAN_GOAL_RECHECK_SEED = 31  # the re-check's LHS starts: neither the polish's (21) nor a validation seed (9001 - 9008)
 MEAN_GOAL_RECHECK_N = 4      # the deep polish's best few re-checked (each a different profile after repair_rates)
 MEAN_GOAL_RECHECK_MI = 1.5   # the re-check's %MI margin under the goal's 2 % (the polish's %MI was chosen on its starts)
+MEAN_GOAL_DEEP_STARTS = 1    # deep polishes, from the best this many scan points (within time, amplitude, acceleration)
 
 
 def insert_excursion(segments, index, offset_s, to_hz, f0=0.0, max_rate_hz_s=MAX_RATE_HZ_S):
@@ -853,7 +854,7 @@ def mean_goal_chain(st, start, profile, budget):
     # The polish starts from the best mean among the points within the time, amplitude and acceleration bounds (%MI is
     # left to COBYLA, which handles it as a constraint: one excursion can add a few stuck runs); the design is never a
     # point over any bound: the fallback is the best point within all of them (the shaken design when it is within).
-    scan, best, best_all = [], None, None
+    scan, best, best_all, ranked = [], None, None, []
     for name, sg in cands:
         s, (ok, hard), T, rate = check_point(name, sg, scan_runs)
         scan.append({"point": name, "mean": s["ir"]["mean"], "pct_mi": s["ir"]["pct_mi"], "amp_max_mm": s["amp_max_mm"],
@@ -862,6 +863,8 @@ def mean_goal_chain(st, start, profile, budget):
                f"amplitude {s['amp_max_mm']:.4f} mm{'' if ok else ' (outside the bounds)'}")
         if hard and (best is None or s["ir"]["mean"] < best[2]):
             best = (name, sg, s["ir"]["mean"])
+        if hard and name != "shaken":
+            ranked.append((s["ir"]["mean"], name, sg))
         if ok and (best_all is None or s["ir"]["mean"] < best_all[2]):
             best_all = (name, sg, s["ir"]["mean"])
     if best is None:
@@ -870,20 +873,29 @@ def mean_goal_chain(st, start, profile, budget):
            f"{best_all[0] + f' ({best_all[2]:.3f})' if best_all else 'none'}")
     steps.append({"step": "scan", "points": scan, "best": best[0], "best_within": best_all and best_all[0]})
 
-    # 3. COBYLA from the scan's best (the deep family needs the excursion; from "shaken" the chain ends here)
+    # 3. COBYLA from the scan's best (the deep family needs the excursion; from "shaken" the chain ends here), and with
+    # MEAN_GOAL_DEEP_STARTS > 1 from the next best scan points too (each its own polish, its own folder)
     cands, seen = [], set()  # (name, profile, history row or None, segments slowed)
     if best[0] != "shaken":
         base = set_section_value(deep_text, "runs", d_runs)
-        x0, clipped = design_x(best[1], base)
-        if clipped:
-            st.log(f"[mean goal] the scan's best lies outside the deep family's bounds in {', '.join(clipped)}: clipped")
-        r = st.optimize("f1_mu02_deep_6balls", set_x0(base, x0), d_evals)
-        rows = list(csv.DictReader(open(os.path.join(st.out, "f1_mu02_deep_6balls", "history.csv"))))
-        names = [c for c in rows[0] if re.fullmatch(r"(f|dt)\d+", c)] if rows else []
-        good = [w for w in rows if w["ok"] == "1" and all(float(w[g]) <= 1e-6 for g in
-                                                          ("g_startup_time", "g_amplitude", "g_pct_mi"))]
-        steps.append({"step": "deep polish", "in_sample": r["best"]["objective"], "feasible": bool(r["best"]["feasible"]),
-                      "runs": d_runs})
+        good, names = [], []
+        for j, (_, sname, sg) in enumerate(sorted(ranked, key=lambda c: c[0])[:max(1, MEAN_GOAL_DEEP_STARTS)]):
+            x0, clipped = design_x(sg, base)
+            if clipped:
+                st.log(f"[mean goal] scan point {sname} lies outside the deep family's bounds in {', '.join(clipped)}: "
+                       "clipped")
+            pname = "f1_mu02_deep_6balls" + ("" if j == 0 else f"_start{j + 1}")
+            r = st.optimize(pname, set_x0(base, x0), d_evals)
+            rows = list(csv.DictReader(open(os.path.join(st.out, pname, "history.csv"))))
+            names = names or ([c for c in rows[0] if re.fullmatch(r"(f|dt)\d+", c)] if rows else [])
+            for w in rows:
+                w["polish"] = pname
+            good += [w for w in rows if w["ok"] == "1" and all(float(w[g]) <= 1e-6 for g in
+                                                               ("g_startup_time", "g_amplitude", "g_pct_mi"))]
+            st.log(f"[mean goal] deep polish {j + 1} from {sname}: in sample {r['best']['objective']:.3f} "
+                   f"(feasible {r['best']['feasible']})")
+            steps.append({"step": "deep polish", "from": sname, "in_sample": r["best"]["objective"],
+                          "feasible": bool(r["best"]["feasible"]), "runs": d_runs})
         # 4. the best few within the time, amplitude and %MI bounds in sample, each repaired onto the acceleration bound,
         # re-checked on more starts of another LHS seed; the design = the best mean there among those within every bound
         # with a %MI margin (MEAN_GOAL_RECHECK_MI): the polish's own starts chose them, so its %MI carries its luck
@@ -899,14 +911,15 @@ def mean_goal_chain(st, start, profile, budget):
             key = tuple((round(f_, 6), round(dt_, 6)) for f_, dt_ in segs_r)
             if key not in seen:
                 seen.add(key)
-                cands.append((f"deep_eval{int(w['evaluation'])}", segs_r, w, slowed))
+                tag = w["polish"][len("f1_mu02_deep_6balls"):]
+                cands.append((f"deep{tag}_eval{int(w['evaluation'])}", segs_r, w, slowed))
     if best_all:  # the best scan point within every bound competes on the same starts
         cands.append((best_all[0], best_all[1], None, []))
     final = None
     for name, segs_r, w, slowed in cands:
         s, (ok, _), T, rate = check_point(name + "_recheck", segs_r, r_runs, MEAN_GOAL_RECHECK_SEED)
         ok = ok and s["ir"]["pct_mi"] <= MEAN_GOAL_RECHECK_MI
-        src = (f"evaluation {w['evaluation']} ({float(w['objective']):.3f} in the polish, acceleration "
+        src = (f"evaluation {w['evaluation']} of {w['polish']} ({float(w['objective']):.3f} in the polish, acceleration "
                f"{float(w['peak_angular_acceleration_rad_s2']):.1f} rad/s^2, segments {slowed} slowed)" if w else
                "the scan's best within every bound")
         st.log(f"[mean goal] re-check of {src}: {s['ir']['mean']:.3f} on {r_runs} LHS starts (seed "
@@ -1026,7 +1039,8 @@ def main():
                       + sum(g + f3_polishes[n] * p for n, (g, _, p, _) in f3_budget.items()) + f2q_budget[0]
                       + 4 * f2q_budget[2] + 2)
     n_designs += sum(f3_polishes.values()) + len(shake_budget) + 1  # 4c's three designs and its deep step
-    st.evals_total += sum(e for e, _ in shake_budget) + (mean_budget[0][0] + mean_budget[2][0] if mean_goal else 0)
+    st.evals_total += sum(e for e, _ in shake_budget) + (mean_budget[0][0] + MEAN_GOAL_DEEP_STARTS * mean_budget[2][0]
+                                                          if mean_goal else 0)
     st.runs_total = ((n_designs + 1) * val_runs * 4 + 7 * (val_runs * 2 + (switch_runs * 2 if contact == "none" else 0))
                      + (len(DRIVE_MADE) + 1) * val_runs
                      + len(counts) * 3 * val_runs + (sum(f3_polishes.values()) + 1 + len(shake_budget)) * val_runs
