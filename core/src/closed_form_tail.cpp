@@ -4,10 +4,53 @@
 #include <array>
 #include <cmath>
 #include <complex>
+#include <utility>
 
 #include "sim_run_state.hpp"
 
 namespace abuopt::detail {
+
+namespace {
+
+// The table's static balance at speed W with every ball stuck at the angles in y: the steady
+// offset (x_s, y_s) of section 6, (1-W^2) x - 2 bbar W y = W^2 U_x, 2 bbar W x + (1-W^2) y = W^2 U_y.
+std::array<double, 2> static_balance(const RunState& rs, const std::vector<double>& y, double W) {
+  const double bb = rs.nd.bbar;
+  double Cx = rs.nd.mbar_I * rs.nd.ebar, Cy = 0;
+  for (std::size_t i = 0; i < rs.n; ++i) {
+    Cx += rs.nd.mbar[i] * std::cos(y[rs.lay().beta(i)]);
+    Cy += rs.nd.mbar[i] * std::sin(y[rs.lay().beta(i)]);
+  }
+  Cx *= W * W;
+  Cy *= W * W;
+  const double a11 = 1 - W * W, a12 = -2 * bb * W, a21 = 2 * bb * W, a22 = 1 - W * W;
+  const double det = a11 * a22 - a12 * a21;
+  return {(Cx * a22 - a12 * Cy) / det, (a11 * Cy - Cx * a21) / det};
+}
+
+// The amplitude peak of a tail e(t) = V exp(Lambda t) c about the steady offset zs (the table's x
+// and y are the first two components): sampled at a twentieth of the fastest period over 20 of the
+// slowest time constants, when the bound |zs| + sum_k |v_k (x, y)| |c_k| can exceed the peak so far.
+template <class Vm, class Lm, class Cm, class XyAt>
+void sample_tail_peak(const Vm& V, const Lm& lam, const Cm& c, double zs_norm, double span_max, double L_mm,
+                      XyAt xy_at, double& peak_amp) {
+  double transient = 0;
+  for (int k = 0; k < lam.size(); ++k) transient += std::hypot(std::abs(V(0, k)), std::abs(V(1, k))) * std::abs(c[k]);
+  if ((zs_norm + transient) * L_mm <= peak_amp) return;
+  double slowest = 0, fastest = 0;
+  for (int k = 0; k < lam.size(); ++k) {
+    slowest = std::max(slowest, -1.0 / lam[k].real());
+    fastest = std::max(fastest, std::abs(lam[k].imag()));
+  }
+  const double span = std::min(span_max, 20.0 * slowest);
+  const double dt = fastest > 0 ? std::min(0.05 / fastest * kTwoPi, span / 16) : span / 16;
+  for (double s = 0; s <= span; s += std::max(dt, 1e-9)) {
+    const auto [x, y] = xy_at(s);
+    peak_amp = std::max(peak_amp, std::hypot(x, y) * L_mm);
+  }
+}
+
+}  // namespace
 
 // Closed-form tail: profile over (W constant, W' = 0), every ball stuck, ideal motor. The table
 // state z = (x, y, x', y') obeys z' = A z + f; with e = z - z_s, e(t) = V exp(Lambda t) V^-1 e0.
@@ -21,16 +64,8 @@ bool closed_form_tail(RunState& rs, double tbar, std::vector<double>& y, double 
   Eigen::Matrix4d A;
   A << 0, 0, 1, 0, 0, 0, 0, 1, W * W - 1, 2 * bb * W, -2 * bb, 2 * W, -2 * bb * W, W * W - 1, -2 * W, -2 * bb;
   // Steady state from the forces with zero table velocity: solve the 2x2 static balance.
-  double Cx = rs.nd.mbar_I * rs.nd.ebar, Cy = 0;
-  for (std::size_t i = 0; i < rs.n; ++i) {
-    Cx += rs.nd.mbar[i] * std::cos(y[rs.lay().beta(i)]);
-    Cy += rs.nd.mbar[i] * std::sin(y[rs.lay().beta(i)]);
-  }
-  Cx *= W * W;
-  Cy *= W * W;
-  const double a11 = 1 - W * W, a12 = -2 * bb * W, a21 = 2 * bb * W, a22 = 1 - W * W;
-  const double det = a11 * a22 - a12 * a21;
-  Eigen::Vector4d zs((Cx * a22 - a12 * Cy) / det, (a11 * Cy - Cx * a21) / det, 0, 0);
+  const auto [xs, ys_] = static_balance(rs, y, W);
+  Eigen::Vector4d zs(xs, ys_, 0, 0);
   // z is the table part of the state: StateLayout::x, y, x_dot, y_dot are its first four entries.
   static_assert(StateLayout::x == 0 && StateLayout::y == 1 && StateLayout::x_dot == 2 && StateLayout::y_dot == 3);
   Eigen::Vector4d e0(y[0] - zs[0], y[1] - zs[1], y[2], y[3]);
@@ -87,22 +122,12 @@ bool closed_form_tail(RunState& rs, double tbar, std::vector<double>& y, double 
     for (int k = 0; k < 4; ++k) ex[k] = c[k] * std::exp(lam[k] * dt);
     return Eigen::Vector4d(zs + (V * ex).real());
   };
-  double transient = 0;
-  for (int k = 0; k < 4; ++k) transient += std::hypot(std::abs(V(0, k)), std::abs(V(1, k))) * std::abs(c[k]);
-  const double L_mm = rs.params.ball_track_radius_m * 1e3;
-  if ((std::hypot(zs[0], zs[1]) + transient) * L_mm > peak_amp) {
-    double slowest = 0, fastest = 0;
-    for (int k = 0; k < 4; ++k) {
-      slowest = std::max(slowest, -1.0 / lam[k].real());
-      fastest = std::max(fastest, std::abs(lam[k].imag()));
-    }
-    const double span = std::min(tbar_end - tbar, 20.0 * slowest);
-    const double dt = fastest > 0 ? std::min(0.05 / fastest * kTwoPi, span / 16) : span / 16;
-    for (double s = 0; s <= span; s += std::max(dt, 1e-9)) {
-      const Eigen::Vector4d z = state_at(s);
-      peak_amp = std::max(peak_amp, std::hypot(z[0], z[1]) * L_mm);
-    }
-  }
+  sample_tail_peak(V, lam, c, std::hypot(zs[0], zs[1]), tbar_end - tbar, rs.params.ball_track_radius_m * 1e3,
+                   [&](double s) {
+                     const Eigen::Vector4d z = state_at(s);
+                     return std::pair<double, double>(z[0], z[1]);
+                   },
+                   peak_amp);
   const Eigen::Vector4d zend = state_at(tbar_end - tbar);
   for (int k = 0; k < 4; ++k) y[k] = zend[k];
   return true;
@@ -134,18 +159,9 @@ bool closed_form_tail_pi(RunState& rs, double tbar, std::vector<double>& y, doub
   // The equilibrium: the table's static balance at W_ref (as the ideal tail), delta from W' = 0.
   std::vector<double> ys(y);
   {
-    const double W = W_ref;
-    double Cx = rs.nd.mbar_I * rs.nd.ebar, Cy = 0;
-    for (std::size_t i = 0; i < rs.n; ++i) {
-      Cx += rs.nd.mbar[i] * std::cos(y[lay.beta(i)]);
-      Cy += rs.nd.mbar[i] * std::sin(y[lay.beta(i)]);
-    }
-    Cx *= W * W;
-    Cy *= W * W;
-    const double a11 = 1 - W * W, a12 = -2 * bb * W, a21 = 2 * bb * W, a22 = 1 - W * W;
-    const double det = a11 * a22 - a12 * a21;
-    ys[0] = (Cx * a22 - a12 * Cy) / det;
-    ys[1] = (a11 * Cy - Cx * a21) / det;
+    const auto [xs, ys_] = static_balance(rs, y, W_ref);
+    ys[0] = xs;
+    ys[1] = ys_;
     ys[2] = ys[3] = 0;
     ys[iw] = W_ref;
     ys[id] = 0;
@@ -242,22 +258,12 @@ bool closed_form_tail_pi(RunState& rs, double tbar, std::vector<double>& y, doub
     for (int k = 0; k < 6; ++k) out[k] += ys[idx[k]];
     return out;
   };
-  double transient = 0;
-  for (int k = 0; k < 6; ++k) transient += std::hypot(std::abs(V(0, k)), std::abs(V(1, k))) * std::abs(c[k]);
-  const double L_mm = rs.params.ball_track_radius_m * 1e3;
-  if ((std::hypot(ys[0], ys[1]) + transient) * L_mm > peak_amp) {
-    double slowest = 0, fastest = 0;
-    for (int k = 0; k < 6; ++k) {
-      slowest = std::max(slowest, -1.0 / lam[k].real());
-      fastest = std::max(fastest, std::abs(lam[k].imag()));
-    }
-    const double span = std::min(tbar_end - tbar, 20.0 * slowest);
-    const double dt = fastest > 0 ? std::min(0.05 / fastest * kTwoPi, span / 16) : span / 16;
-    for (double s = 0; s <= span; s += std::max(dt, 1e-9)) {
-      const auto z = state_at(s);
-      peak_amp = std::max(peak_amp, std::hypot(z[0], z[1]) * L_mm);
-    }
-  }
+  sample_tail_peak(V, lam, c, std::hypot(ys[0], ys[1]), tbar_end - tbar, rs.params.ball_track_radius_m * 1e3,
+                   [&](double s) {
+                     const auto z = state_at(s);
+                     return std::pair<double, double>(z[0], z[1]);
+                   },
+                   peak_amp);
   const auto qend = state_at(tbar_end - tbar);
   for (int k = 0; k < 6; ++k) y[idx[k]] = qend[k];
   return true;
