@@ -13,6 +13,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <cstdio>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -406,29 +407,47 @@ TEST(EvaluationArchive, SchemaVersionIsWrittenAndCheckedWithAClearMessage) {
 // the version) is written in one transaction, so a kill leaves either no schema or all of it.
 // Before, a kill between the first table and the version left "schema version 0" behind, and the
 // resumed study refused its own archive (seen in CI: CompareCli.KilledComparisonResumesFromItsArchives).
-// A child creates fresh archives in a loop; it is killed after 0.5 - 15 ms, 40 times (fixed seed).
+// A child creates fresh archives in a loop and reports each one through a pipe; the parent times
+// the child's second archive (c), then kills it after a random 0 - 2c (fixed seed), 100 times. The
+// delay scales with the machine (a sanitizer build is several times slower), so the kills land
+// inside creations on any machine; before the fix this found 3 - 8 such files per run (four runs).
 TEST(EvaluationArchive, AnArchiveKilledWhileItIsCreatedOpensAgain) {
   const fs::path dir = fs::path(archive_path("creation")).parent_path() / "creation";
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::uint32_t lcg = 12345;
-  int opened = 0;
-  for (int round = 0; round < 40; ++round) {
+  const int rounds = 100;
+  for (int round = 0; round < rounds; ++round) {
+    int fds[2];
+    ASSERT_EQ(pipe(fds), 0);
     const pid_t pid = fork();
     ASSERT_GE(pid, 0);
     if (pid == 0) {
+      close(fds[0]);
       for (int i = 0;; ++i) {
-        EvaluationArchive a((dir / ("r" + std::to_string(round) + "_" + std::to_string(i) + ".sqlite")).string(),
-                            "p");
+        char name[64];
+        std::snprintf(name, sizeof name, "r%d_%d.sqlite", round, i);
+        { EvaluationArchive a((dir / name).string(), "p"); }
+        if (write(fds[1], "x", 1) != 1) _exit(1);
       }
     }
+    close(fds[1]);
+    char byte = 0;
+    const bool first = read(fds[0], &byte, 1) == 1;  // the first archive is complete
+    const auto t0 = std::chrono::steady_clock::now();
+    const bool second = first && read(fds[0], &byte, 1) == 1;  // and the second: its time is one creation
+    const double c_us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
     lcg = lcg * 1664525u + 1013904223u;
-    std::this_thread::sleep_for(std::chrono::microseconds(500 + (lcg >> 8) % 14500));
-    kill(pid, SIGKILL);
+    const double frac = static_cast<double>(lcg >> 8) / static_cast<double>(1u << 24);  // [0, 1)
+    if (second) std::this_thread::sleep_for(std::chrono::microseconds(static_cast<long>(2.0 * c_us * frac)));
+    kill(pid, SIGKILL);  // on every path: the child never ends by itself
     int status = 0;
     waitpid(pid, &status, 0);
+    close(fds[0]);
+    ASSERT_TRUE(second) << "the child did not report two archives";
     ASSERT_TRUE(WIFSIGNALED(status));
   }
+  int opened = 0;
   for (const auto& entry : fs::directory_iterator(dir)) {
     if (entry.path().extension() != ".sqlite") continue;
     try {
@@ -438,7 +457,7 @@ TEST(EvaluationArchive, AnArchiveKilledWhileItIsCreatedOpensAgain) {
       ADD_FAILURE() << "an archive killed while it was created does not open: " << e.what();
     }
   }
-  EXPECT_GE(opened, 20);  // most children had begun an archive
+  EXPECT_GE(opened, 2 * rounds);  // every child completed two archives before it was killed
   fs::remove_all(dir);
 }
 
