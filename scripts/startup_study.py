@@ -48,8 +48,9 @@ kept; rerun the same command after an interruption):
      automatic; mean_goal_chain): formulation 1's k4_hold design with one fast up-shake inserted into its dwell (T
      kept) polished with six balls of equal total mass (configs/studies/mu02/f1_mu02_shake_polish_6balls.yaml, COBYLA
      40 x 256 LHS starts), a deep fast down excursion inserted into the result's first dwell (T kept) scanned over
-     MEAN_GOAL_OFFSETS_S x MEAN_GOAL_BOTTOMS_HZ on the polish's starts, COBYLA from the scan's best
-     (f1_mu02_deep_polish_6balls.yaml, 100 x 256), its best MEAN_GOAL_RECHECK_N evaluations within the time, amplitude
+     MEAN_GOAL_OFFSETS_S x MEAN_GOAL_BOTTOMS_HZ on the polish's starts, COBYLA from the scan's best point with an
+     excursion, also when the shaken design itself scanned better (f1_mu02_deep_polish_6balls.yaml, 100 x 256; from
+     the best MEAN_GOAL_DEEP_STARTS points, default 1), its best MEAN_GOAL_RECHECK_N evaluations within the time, amplitude
      and %MI bounds slowed onto the acceleration bound (repair_rates) and, with the scan's best within every bound,
      re-checked on 1024 LHS starts of another seed (MEAN_GOAL_RECHECK_SEED); the best there within every bound with
      %MI <= MEAN_GOAL_RECHECK_MI (a margin: the polish chose on its own starts) is the design
@@ -694,9 +695,12 @@ F3_ONE_POLISH = ("f3_robust_k6",)
 # bound). The re-check because the polish's in-sample %MI carries its starts' luck: at 80 x 512 its best, 1.95 % in
 # sample (bound 2), was 2.15 - 2.34 % out of sample (h-run02); and the best few, not the best: neighbours differ by more
 # than their in-sample order says (run03: the polish's 6.60 / 6.61 / 6.62 / 6.86 re-checked 6.45 / 6.38 / 6.56 / 6.77).
-# Not robust to the starts: with the polish / scan LHS seed 21 (the config's) the design is 6.38 / 6.23 / 6.28 out of
-# sample (9001 / 9002 / 9004, %MI <= 0.39 %); the same chain with seed 22 has no design (no deep-polish point within T and
-# %MI at once), with seed 23 its design is 8.97 on the re-check's starts (h-run03's report).
+# Not robust to the starts: from the version-5 run's stage-1 design, with the polish / scan LHS seed 21 (the config's)
+# the design is 6.38 / 6.23 / 6.28 out of sample (9001 / 9002 / 9004, %MI <= 0.39 %); with seed 22 the chain has no
+# design (no deep-polish point within T and %MI at once), with seed 23 its design is 8.97 on the re-check's starts
+# (h-run03's report). From the version-6 run's stage-1 design, seeds 21 - 25: 6.26 / 5.92, 8.77 / 8.85, 7.01 / 7.14 (with
+# the polish even when the shaken design scans best; 9.78 without), 6.44 / 6.58, 6.72 / 6.63 (9001 / 9002; the document's
+# 8.13, "The spread of the recipe").
 MEAN_GOAL_MU = 0.02
 MEAN_GOAL_BALLS = 6
 MEAN_GOAL_UP_HZ = 2.2        # f1_mu02_shake_polish_c.yaml's x0: up 2.2 Hz and back, 2.77 s into the dwell
