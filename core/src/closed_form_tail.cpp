@@ -138,11 +138,13 @@ bool closed_form_tail(RunState& rs, double tbar, std::vector<double>& y, double 
 // q = (x, y, x', y', delta, W). Its equilibrium q_s (z_s of the ideal tail at W_ref, delta_s from
 // W' = 0, polished by one Newton step on the full right-hand side) and the linearisation
 // q' = A (q - q_s) are taken from the simulator's own right-hand side and root functions by central
-// differences (the right-hand side is at most quadratic in q: exact up to rounding). The bound on
-// every root function is that of the ideal tail with A 6 x 6. The neglected terms are second order
-// in the deviation; they are kept small relative to the first-order ones by two conditions:
-// |W - W_ref| <= 1e-3 W_ref, and the bound may use at most half of every margin (the other half is
-// the reserve for them). Not a proof: checked against integration (tests/core/closed_form_tail_pi_test.cpp).
+// differences (the right-hand side is a low-degree polynomial in q, and the differences' truncation
+// error lies far below the residual tolerance). The bound on every root function is that of the ideal
+// tail with A 6 x 6. The neglected terms are second order in the deviation; they are kept small
+// relative to the first-order ones by two conditions: |W - W_ref| <= 1e-3 W_ref now and along the
+// whole linear tail (its bound sum_k |V(W, k)| |c_k|: the drive's oscillation crosses W_ref while it
+// has not settled), and the bound may use at most half of every margin (the other half is the
+// reserve for them). Not a proof: checked against integration (tests/core/closed_form_tail_pi_test.cpp).
 bool closed_form_tail_pi(RunState& rs, double tbar, std::vector<double>& y, double tbar_end, double& peak_amp,
                          void (*roots)(double, const double*, double*, void*)) {
   if (!rs.pi_motor) return false;
@@ -158,6 +160,7 @@ bool closed_form_tail_pi(RunState& rs, double tbar, std::vector<double>& y, doub
 
   // The equilibrium: the table's static balance at W_ref (as the ideal tail), delta from W' = 0.
   std::vector<double> ys(y);
+  double wp_scale = 0;
   {
     const auto [xs, ys_] = static_balance(rs, y, W_ref);
     ys[0] = xs;
@@ -174,6 +177,8 @@ bool closed_form_tail_pi(RunState& rs, double tbar, std::vector<double>& y, doub
     const double load = -rs.motor.bearing_torque_Nm * std::clamp(W_ref * rs.omega_n / 0.1, -1.0, 1.0);
     const double wm = rs.motor.omega_m_rad_s;
     ys[id] = -(load + torque) / (rs.motor.inertia_kgm2 * wm * wm);
+    // the size of the W' row's terms (nondimensional), for its residual's tolerance
+    wp_scale = (std::fabs(load) + std::fabs(torque)) / rs.motor.inertia_kgm2 / (rs.omega_n * rs.omega_n);
   }
   const std::size_t nv = lay.size() + 2;
   std::vector<double> f(nv), fp(nv), fm(nv), q(ys);
@@ -183,7 +188,10 @@ bool closed_form_tail_pi(RunState& rs, double tbar, std::vector<double>& y, doub
   };
   auto steps = [&](const std::vector<double>& at) {
     std::array<double, 6> h{};
-    const double zn = std::max(std::hypot(at[0], at[1]), 1e-12);
+    // the table's step: relative to the largest of the offset, the imbalance and the deviation (an
+    // ABU balanced almost exactly has a tiny offset but terms of the imbalance's size)
+    const double zn = std::max({std::hypot(at[0], at[1]), rs.nd.mbar_I * rs.nd.ebar, std::hypot(y[0] - at[0], y[1] - at[1]),
+                                1e-12});
     for (int k = 0; k < 4; ++k) h[k] = 1e-4 * zn;
     h[4] = 1e-6 * std::max(1.0, std::fabs(at[id]));
     h[5] = 1e-6 * std::max(1.0, std::fabs(at[iw]));
@@ -214,7 +222,7 @@ bool closed_form_tail_pi(RunState& rs, double tbar, std::vector<double>& y, doub
   rhs6(ys, r);
   const double scale = W_ref * W_ref * (std::hypot(ys[0], ys[1]) + rs.nd.mbar_I * rs.nd.ebar);
   if (!(r.template head<4>().norm() <= 1e-9 * scale && std::fabs(r[4]) <= 1e-9 * W_ref &&
-        std::fabs(r[5]) <= 1e-9 * W_ref))
+        std::fabs(r[5]) <= 1e-9 * std::max(wp_scale, 1e-6 * W_ref * W_ref)))
     return false;
 
   Eigen::EigenSolver<Eigen::Matrix<double, 6, 6>> es(A);
@@ -227,6 +235,9 @@ bool closed_form_tail_pi(RunState& rs, double tbar, std::vector<double>& y, doub
   for (int k = 0; k < 6; ++k) e0[k] = y[idx[k]] - ys[idx[k]];
   const Eigen::Matrix<std::complex<double>, 6, 1> c = V.partialPivLu().solve(e0.cast<std::complex<double>>());
   if (!c.allFinite()) return false;
+  double speed_bound = 0;  // |W(t) - W_ref| <= this along the linear tail
+  for (int k = 0; k < 6; ++k) speed_bound += std::abs(V(5, k)) * std::abs(c[k]);
+  if (!(speed_bound <= 1e-3 * W_ref)) return false;
 
   // The root functions at q_s and their gradients.
   const std::size_t nr = rs.nroots();

@@ -242,7 +242,8 @@ EvaluationArchive::EvaluationArchive(const std::string& path, std::string proble
     // The schema (three tables and the version) in one transaction: a process killed while it
     // creates the archive leaves no schema or all of it, never tables without their version
     // (which the check above would refuse on resume).
-    exec("BEGIN IMMEDIATE");
+    // (an existing archive needs no write lock here: at most the metadata table is added, one statement)
+    if (!existing) exec("BEGIN IMMEDIATE");
     try {
       exec(
           "CREATE TABLE IF NOT EXISTS evaluations ("
@@ -273,9 +274,9 @@ EvaluationArchive::EvaluationArchive(const std::string& path, std::string proble
           " abuopt_version TEXT NOT NULL, git_commit TEXT NOT NULL, command TEXT NOT NULL, config TEXT NOT NULL,"
           " config_hash TEXT NOT NULL)");
       if (!existing) exec(("PRAGMA user_version = " + std::to_string(kSchemaVersion)).c_str());
-      exec("COMMIT");
+      if (!existing) exec("COMMIT");
     } catch (...) {
-      sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+      if (!existing) sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
       throw;
     }
   } catch (const ConfigError&) {
