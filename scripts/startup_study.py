@@ -699,7 +699,7 @@ F3_ONE_POLISH = ("f3_robust_k6",)
 # the design is 6.38 / 6.23 / 6.28 out of sample (9001 / 9002 / 9004, %MI <= 0.39 %); with seed 22 the chain has no
 # design (no deep-polish point within T and %MI at once), with seed 23 its design is 8.97 on the re-check's starts
 # (h-run03's report). From the version-6 run's stage-1 design, seeds 21 - 25: 6.26 / 5.92, 8.77 / 8.85, 7.01 / 7.14 (with
-# the polish even when the shaken design scans best; 9.78 without), 6.44 / 6.58, 6.72 / 6.63 (9001 / 9002; the document's
+# the polish even when the shaken design scans best; 9.78 on the re-check's starts without), 6.44 / 6.58, 6.72 / 6.63 (9001 / 9002; the document's
 # 8.13, "The spread of the recipe").
 MEAN_GOAL_MU = 0.02
 MEAN_GOAL_BALLS = 6
@@ -881,7 +881,7 @@ def mean_goal_chain(st, start, profile, budget):
     # MEAN_GOAL_DEEP_STARTS > 1 from the next best scan points too (each its own polish, its own folder). Also when the
     # shaken design without an excursion is the scan's best: the scan only picks the start, the polish makes the gain
     # (the whole runner of 8.8: scan best 11.56 against 12.21 shaken, polish 6.09), and with the LHS seed 23 the scan's
-    # best was the shaken design, so the chain ended at 9.78 without a polish before this rule.
+    # best was the shaken design, so the chain ended at 9.78 (on the re-check's starts) without a polish before this rule.
     cands, seen = [], set()  # (name, profile, history row or None, segments slowed)
     if ranked:
         base = set_section_value(deep_text, "runs", d_runs)
