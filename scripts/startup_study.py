@@ -712,6 +712,11 @@ MEAN_GOAL_RECHECK_SEED = 31  # the re-check's LHS starts: neither the polish's (
 MEAN_GOAL_RECHECK_N = 4      # the deep polish's best few re-checked (each a different profile after repair_rates)
 MEAN_GOAL_RECHECK_MI = 1.5   # the re-check's %MI margin under the goal's 2 % (the polish's %MI was chosen on its starts)
 MEAN_GOAL_DEEP_STARTS = 1    # deep polishes, from the best this many scan points (within time, amplitude, acceleration)
+# Independent replications of the chain (sample average approximation with replications: each replication polishes
+# and scans on its own LHS starts, seeds 21, 22, ...; every replication's re-check points are re-checked on the same
+# MEAN_GOAL_RECHECK_SEED starts and the best one is the design). One chain reaches the goal from about half of the
+# samples (the spread above); the replications are independent, so two miss together only when both do.
+MEAN_GOAL_REPLICATIONS = 2
 
 
 def insert_excursion(segments, index, offset_s, to_hz, f0=0.0, max_rate_hz_s=MAX_RATE_HZ_S):
@@ -799,10 +804,12 @@ def profile_dict(segs, f0=0.0):
     return {"start_frequency_hz": f0, "segments": [{"end_frequency_hz": f, "duration_s": d} for f, d in segs]}
 
 
-def mean_goal_chain(st, start, profile, budget):
+def mean_goal_chain(st, start, profile, budget, replications=1):
     """Stage 5c (contact hard: the mu02 configs set it): from `start` (a k4_hold profile: ramp, ramp, dwell, ramp to
     100 Hz) the chain of MEAN_GOAL_*'s comment. budget = ((evaluations, starts) of the shake polish, starts of the
-    scan, (evaluations, starts) of the deep polish, (points, starts) of the re-check). Returns a design entry, or None
+    scan, (evaluations, starts) of the deep polish, (points, starts) of the re-check, per replication). `replications`
+    independent chains (steps 1 - 3 and their re-check points; LHS seeds seed, seed + 1, ...), every point re-checked
+    on the same starts and the best one kept (MEAN_GOAL_REPLICATIONS's comment). Returns a design entry, or None
     when no point is within every bound on the re-check's starts."""
     mu02 = os.path.join(ROOT, "configs", "studies", "mu02")
     shake_text, deep_text = (read(os.path.join(mu02, n)) for n in ("f1_mu02_shake_polish_6balls.yaml",
@@ -815,26 +822,6 @@ def mean_goal_chain(st, start, profile, budget):
     f0 = profile.get("start_frequency_hz", 0.0)
     steps = []
 
-    # 1. the up-shake, T kept, polished with six balls
-    segs = segments_of(profile)
-    k = dwells(segs, f0)[0]
-    f, dt = segs[k]
-    d = shake_duration(MEAN_GOAL_UP_HZ)
-    room = dt - 2 * d - MEAN_GOAL_MIN_DWELL_S  # the rest of the dwell keeps the families' least dwell when it can
-    segs = insert_excursion(segs, k, min(MEAN_GOAL_UP_OFFSET_S, room) if room > 0 else 0.5 * (dt - 2 * d),
-                            f + MEAN_GOAL_UP_HZ, f0)
-    base = set_section_value(shake_text, "runs", s_runs)
-    x0, clipped = design_x(segs, base)
-    if clipped:
-        st.log(f"[mean goal] the up-shake start lies outside the family's bounds in {', '.join(clipped)}: clipped")
-    x0 = fit_duration(x0, bounds_of(base), t_max)
-    r = st.optimize("f1_mu02_shake_6balls", set_x0(base, x0), s_evals)
-    shaken = segments_of(r["best"]["profile"])
-    st.log(f"[mean goal] up-shake polished with {len(balls)} balls: in sample {r['best']['objective']:.3f} "
-           f"(feasible {r['best']['feasible']}, {s_runs} starts)")
-    steps.append({"step": "shake polish", "in_sample": r["best"]["objective"], "feasible": bool(r["best"]["feasible"]),
-                  "runs": s_runs})
-
     def check_point(name, segs_, runs, seed_=seed):
         """Runs segs_ on `runs` LHS starts of seed_ (default the polish's seed), mu 0.02, six balls; returns (statistics,
         (within every bound, within T / amplitude / acceleration), T, peak |f'|)."""
@@ -846,82 +833,115 @@ def mean_goal_chain(st, start, profile, budget):
         hard = T <= t_max + 1e-9 and s["amp_max_mm"] <= amp_max and rate <= MAX_RATE_HZ_S
         return s, (hard and s["ir"]["pct_mi"] <= mi_max, hard), T, rate
 
-    # 2. the deep excursion scan, T kept: the shaken design itself and every (offset, bottom) on the same starts
-    kd = dwells(shaken, f0)[0]
-    cands = [("shaken", shaken)]
-    for off in MEAN_GOAL_OFFSETS_S:
-        for bottom in MEAN_GOAL_BOTTOMS_HZ:
-            try:
-                cands.append((f"deep{bottom:g}Hz_at{off:g}s", insert_excursion(shaken, kd, off, bottom, f0)))
-            except ValueError as e:
-                st.log(f"[mean goal] excursion to {bottom:g} Hz at {off:g} s: skipped ({e})")
-    # The polish starts from the best mean among the points within the time, amplitude and acceleration bounds (%MI is
-    # left to COBYLA, which handles it as a constraint: one excursion can add a few stuck runs); the design is never a
-    # point over any bound: the fallback is the best point within all of them (the shaken design when it is within).
-    scan, best, best_all, ranked = [], None, None, []
-    for name, sg in cands:
-        s, (ok, hard), T, rate = check_point(name, sg, scan_runs)
-        scan.append({"point": name, "mean": s["ir"]["mean"], "pct_mi": s["ir"]["pct_mi"], "amp_max_mm": s["amp_max_mm"],
-                     "within": ok})
-        st.log(f"[mean goal] scan {name}: {s['ir']['mean']:.3f} ({scan_runs} starts), %MI {s['ir']['pct_mi']:.2f}, "
-               f"amplitude {s['amp_max_mm']:.4f} mm{'' if ok else ' (outside the bounds)'}")
-        if hard and (best is None or s["ir"]["mean"] < best[2]):
-            best = (name, sg, s["ir"]["mean"])
-        if hard and name != "shaken":
-            ranked.append((s["ir"]["mean"], name, sg))
-        if ok and (best_all is None or s["ir"]["mean"] < best_all[2]):
-            best_all = (name, sg, s["ir"]["mean"])
-    if best is None:
-        best = ("shaken", shaken, scan[0]["mean"])
-    st.log(f"[mean goal] scan best: {best[0]} ({best[2]:.3f}); within every bound: "
-           f"{best_all[0] + f' ({best_all[2]:.3f})' if best_all else 'none'}")
-    steps.append({"step": "scan", "points": scan, "best": best[0], "best_within": best_all and best_all[0]})
+    cands, seen = [], set()  # the re-check's points of every replication: (name, profile, history row or None, slowed)
+    for rep in range(replications):
+        # Replication rep: the same chain with the polish's and the scan's LHS seed seed + rep, its folders and points
+        # suffixed _rep<rep + 1> (none for the first, so a one-replication run is the chain as it was)
+        rseed, sfx = seed + rep, ("" if rep == 0 else f"_rep{rep + 1}")
+        rlog = "[mean goal]" if replications == 1 else f"[mean goal, replication {rep + 1} (seed {rseed})]"
 
-    # 3. COBYLA from the scan's best point with an excursion (the deep family needs one), and with
-    # MEAN_GOAL_DEEP_STARTS > 1 from the next best scan points too (each its own polish, its own folder). Also when the
-    # shaken design without an excursion is the scan's best: the scan only picks the start, the polish makes the gain
-    # (the whole runner of 8.8: scan best 11.56 against 12.21 shaken, polish 6.09), and with the LHS seed 23 the scan's
-    # best was the shaken design, so the chain ended at 9.78 (on the re-check's starts) without a polish before this rule.
-    cands, seen = [], set()  # (name, profile, history row or None, segments slowed)
-    if ranked:
-        base = set_section_value(deep_text, "runs", d_runs)
-        good, names = [], []
-        for j, (_, sname, sg) in enumerate(sorted(ranked, key=lambda c: c[0])[:max(1, MEAN_GOAL_DEEP_STARTS)]):
-            x0, clipped = design_x(sg, base)
-            if clipped:
-                st.log(f"[mean goal] scan point {sname} lies outside the deep family's bounds in {', '.join(clipped)}: "
-                       "clipped")
-            pname = "f1_mu02_deep_6balls" + ("" if j == 0 else f"_start{j + 1}")
-            r = st.optimize(pname, set_x0(base, x0), d_evals)
-            rows = list(csv.DictReader(open(os.path.join(st.out, pname, "history.csv"))))
-            names = names or ([c for c in rows[0] if re.fullmatch(r"(f|dt)\d+", c)] if rows else [])
-            for w in rows:
-                w["polish"] = pname
-            good += [w for w in rows if w["ok"] == "1" and all(float(w[g]) <= 1e-6 for g in
-                                                               ("g_startup_time", "g_amplitude", "g_pct_mi"))]
-            st.log(f"[mean goal] deep polish {j + 1} from {sname}: in sample {r['best']['objective']:.3f} "
-                   f"(feasible {r['best']['feasible']})")
-            steps.append({"step": "deep polish", "from": sname, "in_sample": r["best"]["objective"],
-                          "feasible": bool(r["best"]["feasible"]), "runs": d_runs})
-        # 4. the best few within the time, amplitude and %MI bounds in sample, each repaired onto the acceleration bound,
-        # re-checked on more starts of another LHS seed; the design = the best mean there among those within every bound
-        # with a %MI margin (MEAN_GOAL_RECHECK_MI): the polish's own starts chose them, so its %MI carries its luck
-        for w in sorted(good, key=lambda w: float(w["objective"])):
-            if len(cands) >= r_count:
-                break
-            x = {c: float(w[c]) for c in names}
-            try:
-                segs_r, slowed = repair_rates(segments_of_x(base, x), f0)
-            except ValueError as e:
-                st.log(f"[mean goal] deep polish: evaluation {w['evaluation']} could not be repaired ({e}): skipped")
-                continue
-            key = tuple((round(f_, 6), round(dt_, 6)) for f_, dt_ in segs_r)
-            if key not in seen:
-                seen.add(key)
-                tag = w["polish"][len("f1_mu02_deep_6balls"):]
-                cands.append((f"deep{tag}_eval{int(w['evaluation'])}", segs_r, w, slowed))
-    if best_all:  # the best scan point within every bound competes on the same starts
-        cands.append((best_all[0], best_all[1], None, []))
+        # 1. the up-shake, T kept, polished with six balls
+        segs = segments_of(profile)
+        k = dwells(segs, f0)[0]
+        f, dt = segs[k]
+        d = shake_duration(MEAN_GOAL_UP_HZ)
+        room = dt - 2 * d - MEAN_GOAL_MIN_DWELL_S  # the rest of the dwell keeps the families' least dwell when it can
+        segs = insert_excursion(segs, k, min(MEAN_GOAL_UP_OFFSET_S, room) if room > 0 else 0.5 * (dt - 2 * d),
+                                f + MEAN_GOAL_UP_HZ, f0)
+        base = set_section_value(set_section_value(shake_text, "runs", s_runs), "seed", rseed)
+        x0, clipped = design_x(segs, base)
+        if clipped:
+            st.log(f"{rlog} the up-shake start lies outside the family's bounds in {', '.join(clipped)}: clipped")
+        x0 = fit_duration(x0, bounds_of(base), t_max)
+        r = st.optimize("f1_mu02_shake_6balls" + sfx, set_x0(base, x0), s_evals)
+        shaken = segments_of(r["best"]["profile"])
+        st.log(f"{rlog} up-shake polished with {len(balls)} balls: in sample {r['best']['objective']:.3f} "
+               f"(feasible {r['best']['feasible']}, {s_runs} starts)")
+        steps.append({"step": "shake polish", "replication": rep + 1, "seed": rseed,
+                      "in_sample": r["best"]["objective"], "feasible": bool(r["best"]["feasible"]), "runs": s_runs})
+
+        # 2. the deep excursion scan, T kept: the shaken design itself and every (offset, bottom) on the same starts
+        kd = dwells(shaken, f0)[0]
+        points = [("shaken", shaken)]
+        for off in MEAN_GOAL_OFFSETS_S:
+            for bottom in MEAN_GOAL_BOTTOMS_HZ:
+                try:
+                    points.append((f"deep{bottom:g}Hz_at{off:g}s", insert_excursion(shaken, kd, off, bottom, f0)))
+                except ValueError as e:
+                    st.log(f"{rlog} excursion to {bottom:g} Hz at {off:g} s: skipped ({e})")
+        # The polish starts from the best mean among the points within the time, amplitude and acceleration bounds
+        # (%MI is left to COBYLA, which handles it as a constraint: one excursion can add a few stuck runs); the design
+        # is never a point over any bound: the fallback is the best point within all of them (the shaken design when
+        # it is within).
+        scan, best, best_all, ranked = [], None, None, []
+        for name, sg in points:
+            s, (ok, hard), T, rate = check_point(name + sfx, sg, scan_runs, rseed)
+            scan.append({"point": name + sfx, "mean": s["ir"]["mean"], "pct_mi": s["ir"]["pct_mi"],
+                         "amp_max_mm": s["amp_max_mm"], "within": ok})
+            st.log(f"{rlog} scan {name}: {s['ir']['mean']:.3f} ({scan_runs} starts), %MI {s['ir']['pct_mi']:.2f}, "
+                   f"amplitude {s['amp_max_mm']:.4f} mm{'' if ok else ' (outside the bounds)'}")
+            if hard and (best is None or s["ir"]["mean"] < best[2]):
+                best = (name + sfx, sg, s["ir"]["mean"])
+            if hard and name != "shaken":
+                ranked.append((s["ir"]["mean"], name + sfx, sg))
+            if ok and (best_all is None or s["ir"]["mean"] < best_all[2]):
+                best_all = (name + sfx, sg, s["ir"]["mean"])
+        if best is None:
+            best = ("shaken" + sfx, shaken, scan[0]["mean"])
+        st.log(f"{rlog} scan best: {best[0]} ({best[2]:.3f}); within every bound: "
+               f"{best_all[0] + f' ({best_all[2]:.3f})' if best_all else 'none'}")
+        steps.append({"step": "scan", "replication": rep + 1, "points": scan, "best": best[0],
+                      "best_within": best_all and best_all[0]})
+
+        # 3. COBYLA from the scan's best point with an excursion (the deep family needs one), and with
+        # MEAN_GOAL_DEEP_STARTS > 1 from the next best scan points too (each its own polish, its own folder). Also when
+        # the shaken design without an excursion is the scan's best: the scan only picks the start, the polish makes the
+        # gain (the whole runner of 8.8: scan best 11.56 against 12.21 shaken, polish 6.09), and with the LHS seed 23 the
+        # scan's best was the shaken design, so the chain ended at 9.78 (on the re-check's starts) without a polish
+        # before this rule.
+        mine = 0  # this replication's re-check points from its polish
+        if ranked:
+            base = set_section_value(set_section_value(deep_text, "runs", d_runs), "seed", rseed)
+            good, names = [], []
+            for j, (_, sname, sg) in enumerate(sorted(ranked, key=lambda c: c[0])[:max(1, MEAN_GOAL_DEEP_STARTS)]):
+                x0, clipped = design_x(sg, base)
+                if clipped:
+                    st.log(f"{rlog} scan point {sname} lies outside the deep family's bounds in "
+                           f"{', '.join(clipped)}: clipped")
+                pname = "f1_mu02_deep_6balls" + ("" if j == 0 else f"_start{j + 1}") + sfx
+                r = st.optimize(pname, set_x0(base, x0), d_evals)
+                rows = list(csv.DictReader(open(os.path.join(st.out, pname, "history.csv"))))
+                names = names or ([c for c in rows[0] if re.fullmatch(r"(f|dt)\d+", c)] if rows else [])
+                for w in rows:
+                    w["polish"] = pname
+                good += [w for w in rows if w["ok"] == "1" and all(float(w[g]) <= 1e-6 for g in
+                                                                   ("g_startup_time", "g_amplitude", "g_pct_mi"))]
+                st.log(f"{rlog} deep polish {j + 1} from {sname}: in sample {r['best']['objective']:.3f} "
+                       f"(feasible {r['best']['feasible']})")
+                steps.append({"step": "deep polish", "replication": rep + 1, "from": sname,
+                              "in_sample": r["best"]["objective"], "feasible": bool(r["best"]["feasible"]),
+                              "runs": d_runs})
+            # 4. the best few within the time, amplitude and %MI bounds in sample, each repaired onto the acceleration
+            # bound, re-checked on more starts of another LHS seed; the design = the best mean there among those within
+            # every bound with a %MI margin (MEAN_GOAL_RECHECK_MI): the polish's own starts chose them, so its %MI
+            # carries its luck
+            for w in sorted(good, key=lambda w: float(w["objective"])):
+                if mine >= r_count:
+                    break
+                x = {c: float(w[c]) for c in names}
+                try:
+                    segs_r, slowed = repair_rates(segments_of_x(base, x), f0)
+                except ValueError as e:
+                    st.log(f"{rlog} deep polish: evaluation {w['evaluation']} could not be repaired ({e}): skipped")
+                    continue
+                key = tuple((round(f_, 6), round(dt_, 6)) for f_, dt_ in segs_r)
+                if key not in seen:
+                    seen.add(key)
+                    mine += 1
+                    tag = w["polish"][len("f1_mu02_deep_6balls"):]
+                    cands.append((f"deep{tag}_eval{int(w['evaluation'])}", segs_r, w, slowed))
+        if best_all:  # the best scan point within every bound competes on the same starts
+            cands.append((best_all[0], best_all[1], None, []))
     final = None
     for name, segs_r, w, slowed in cands:
         s, (ok, _), T, rate = check_point(name + "_recheck", segs_r, r_runs, MEAN_GOAL_RECHECK_SEED)
@@ -973,6 +993,10 @@ def main():
                     help="stage 8, the stop-depth families of the limit analysis (scripts/stop_depth_study.py): quick "
                          "(default, a subset with the published deepest cases, about 3 min of one core), full (the "
                          "published grids, about 35 min of one core), none")
+    ap.add_argument("--mean-goal-replications", type=int, default=MEAN_GOAL_REPLICATIONS,
+                    help=f"stage 5c, the mean goal: independent replications of its chain, each on its own LHS starts, "
+                         f"the best on common re-check starts kept (default {MEAN_GOAL_REPLICATIONS}; each adds about "
+                         f"1 min of 2 cores)")
     a = ap.parse_args()
     if a.out is None:
         a.out = os.path.join("results", "startup_study_contact" if a.contact == "hard" else "startup_study")
@@ -984,6 +1008,8 @@ def main():
         sys.exit(f"--scale {a.scale}: must be > 0")
     if a.shake_balls < 2:
         sys.exit(f"--shake-balls {a.shake_balls}: must be >= 2")
+    if a.mean_goal_replications < 1:
+        sys.exit(f"--mean-goal-replications {a.mean_goal_replications}: must be >= 1")
     if a.val_runs < 2:
         sys.exit(f"--val-runs {a.val_runs}: must be >= 2")
     if not os.access(a.abuopt, os.X_OK):
@@ -1046,16 +1072,17 @@ def main():
                       + sum(g + f3_polishes[n] * p for n, (g, _, p, _) in f3_budget.items()) + f2q_budget[0]
                       + 4 * f2q_budget[2] + 2)
     n_designs += sum(f3_polishes.values()) + len(shake_budget) + 1  # 4c's three designs and its deep step
-    st.evals_total += sum(e for e, _ in shake_budget) + (mean_budget[0][0] + MEAN_GOAL_DEEP_STARTS * mean_budget[2][0]
-                                                          if mean_goal else 0)
+    st.evals_total += sum(e for e, _ in shake_budget) + (
+        a.mean_goal_replications * (mean_budget[0][0] + MEAN_GOAL_DEEP_STARTS * mean_budget[2][0]) if mean_goal else 0)
     st.runs_total = ((n_designs + 1) * val_runs * 4 + 7 * (val_runs * 2 + (switch_runs * 2 if contact == "none" else 0))
                      + (len(DRIVE_MADE) + 1) * val_runs
                      + len(counts) * 3 * val_runs + (sum(f3_polishes.values()) + 1 + len(shake_budget)) * val_runs
                      + 8 * val_runs  # the shake designs' mu 0.03 on seed 9002; 4 with N balls on 2 seeds
                      + (len(DEEP_BOTTOMS_HZ) + 1) * shake_budget[0][1]  # 4c's deep scan
                      + (4 * len(SHIPPED) if contact == "hard" else 0) * val_runs  # the shipped designs and their 2003
-                     + ((1 + len(MEAN_GOAL_OFFSETS_S) * len(MEAN_GOAL_BOTTOMS_HZ)) * mean_budget[1]
-                        + (mean_budget[3][0] + 1) * mean_budget[3][1] + 2 * val_runs if mean_goal else 0))  # 5c
+                     + (a.mean_goal_replications * ((1 + len(MEAN_GOAL_OFFSETS_S) * len(MEAN_GOAL_BOTTOMS_HZ))
+                                                    * mean_budget[1] + (mean_budget[3][0] + 1) * mean_budget[3][1])
+                        + 2 * val_runs if mean_goal else 0))  # 5c
 
     st.log(f"startup study, ball contact {contact}: {n_designs} designs, about {st.evals_total} evaluations and "
            f"{st.runs_total} validation runs; output {st.out}")
@@ -1226,7 +1253,7 @@ def main():
     if mean_goal:
         st.stage("5c formulation 1 with six balls: shake and deep excursion at mu 0.02")
         mean_goal_design = mean_goal_chain(st, "f1_k4_hold", designs["f1_k4_hold"]["result"]["best"]["profile"],
-                                           mean_budget)
+                                           mean_budget, a.mean_goal_replications)
 
     # 6. Validation on fresh starts, beside the 2003 profile on the same starts.
     st.stage("6 validation")

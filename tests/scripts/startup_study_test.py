@@ -391,11 +391,23 @@ def end_to_end(abuopt, tmp):
           and "(made by the runner, stage 5c)" in study.read(os.path.join(out, "summary.md"))
           and len(re.findall(r"^    - \{mass_kg", study.read(os.path.join(out, "f1_mu02_shake_6balls", "config.yaml")),
                              re.M)) == 6
-          and "mean_goal_shaken" in scan5c and npoints - 3 <= len([x for x in scan5c if "Hz_at" in x and "recheck" not in x]) + 1 <= npoints
+          and "mean_goal_shaken" in scan5c and npoints - 3 <= len([x for x in scan5c if "Hz_at" in x and "recheck" not in x
+                                                                   and "_rep" not in x]) + 1 <= npoints
           and "# runs 5 seed 21 --mu 0.02 design lhs" in study.read(os.path.join(out, "validation", "mean_goal_shaken",
                                                                                  "config.yaml")),
           f"stage 5c: {mg.get('point') if mg else 'no design within the bounds'}, T {sum(dt for _, dt in segs5c):.3f} s, "
           f"{len(scan5c)} points run, validated on both seeds with six balls (when within the bounds)")
+    # the second replication (MEAN_GOAL_REPLICATIONS, the default 2): the same chain on the LHS starts of seed 22, its
+    # shake polish, its scan (the same points, suffixed _rep2) and its deep polish in folders of their own
+    rep2 = sorted(x for x in scan5c if x.endswith("_rep2"))
+    want2 = sorted(x + "_rep2" for x in scan5c if "_rep" not in x and "recheck" not in x)
+    sh2 = os.path.join(out, "f1_mu02_shake_6balls_rep2", "config.yaml")
+    check(study.MEAN_GOAL_REPLICATIONS == 2 and rep2 == want2 and os.path.exists(sh2)
+          and re.search(r"^  seed: 22\b", study.read(sh2), re.M)
+          and "# runs 5 seed 22 --mu 0.02 design lhs" in study.read(os.path.join(out, "validation", "mean_goal_shaken_rep2",
+                                                                                 "config.yaml"))
+          and [x["seed"] for x in (s["mean_goal"] or {}).get("steps", []) if x["step"] == "shake polish"] in ([21, 22], []),
+          f"stage 5c's second replication: {len(rep2)} scan points on seed 22's starts, its own shake polish")
     # its design = the best of the re-check (LHS starts of MEAN_GOAL_RECHECK_SEED) within every bound with the %MI margin
     rc = [x for x in mg["steps"] if x["step"] == "re-check"] if mg else []
     check(not mg or rc and any(x["point"] == mg["point"] and x["within"] and x["pct_mi"] <= study.MEAN_GOAL_RECHECK_MI
