@@ -277,7 +277,7 @@ def mean_goal(abuopt, tmp, cdir):
 def end_to_end(abuopt, tmp):
     out = os.path.join(tmp, "study")
     cmd = [sys.executable, SCRIPT, "--abuopt", abuopt, "--out", out, "--scale", "0.02", "--val-runs", "8",
-           "--threads", "2", "--nice", "0", "--shake-balls", "3"]
+           "--threads", "2", "--nice", "0", "--shake-balls", "3", "--mean-goal-stop", "0"]  # 5c: every replication
     r = subprocess.run(cmd, capture_output=True, text=True)
     check(r.returncode == 0, f"the study runs end to end (status {r.returncode}) {r.stderr[-2000:]}")
     if r.returncode != 0:
@@ -397,17 +397,20 @@ def end_to_end(abuopt, tmp):
                                                                                  "config.yaml")),
           f"stage 5c: {mg.get('point') if mg else 'no design within the bounds'}, T {sum(dt for _, dt in segs5c):.3f} s, "
           f"{len(scan5c)} points run, validated on both seeds with six balls (when within the bounds)")
-    # the second replication (MEAN_GOAL_REPLICATIONS, the default 2): the same chain on the LHS starts of seed 22, its
-    # shake polish, its scan (the same points, suffixed _rep2) and its deep polish in folders of their own
-    rep2 = sorted(x for x in scan5c if x.endswith("_rep2"))
-    want2 = sorted(x + "_rep2" for x in scan5c if "_rep" not in x and "recheck" not in x)
-    sh2 = os.path.join(out, "f1_mu02_shake_6balls_rep2", "config.yaml")
-    check(study.MEAN_GOAL_REPLICATIONS == 2 and rep2 == want2 and os.path.exists(sh2)
-          and re.search(r"^  seed: 22\b", study.read(sh2), re.M)
-          and "# runs 5 seed 22 --mu 0.02 design lhs" in study.read(os.path.join(out, "validation", "mean_goal_shaken_rep2",
-                                                                                 "config.yaml"))
-          and [x["seed"] for x in (s["mean_goal"] or {}).get("steps", []) if x["step"] == "shake polish"] in ([21, 22], []),
-          f"stage 5c's second replication: {len(rep2)} scan points on seed 22's starts, its own shake polish")
+    # the replications (MEAN_GOAL_REPLICATIONS, the default 3; --mean-goal-stop 0 runs every one): the same chain on the
+    # LHS starts of seeds 22 and 23, each its shake polish, its scan (the same points, suffixed _rep<k>) and its deep
+    # polish in folders of their own
+    for k in range(2, study.MEAN_GOAL_REPLICATIONS + 1):
+        repk = sorted(x for x in scan5c if x.endswith(f"_rep{k}"))
+        wantk = sorted(x + f"_rep{k}" for x in scan5c if "_rep" not in x and "recheck" not in x)
+        shk = os.path.join(out, f"f1_mu02_shake_6balls_rep{k}", "config.yaml")
+        check(study.MEAN_GOAL_REPLICATIONS == 3 and repk == wantk and os.path.exists(shk)
+              and re.search(rf"^  seed: {20 + k}\b", study.read(shk), re.M)
+              and f"# runs 5 seed {20 + k} --mu 0.02 design lhs" in study.read(
+                  os.path.join(out, "validation", f"mean_goal_shaken_rep{k}", "config.yaml")),
+              f"stage 5c's replication {k}: {len(repk)} scan points on seed {20 + k}'s starts, its own shake polish")
+    check([x["seed"] for x in (s["mean_goal"] or {}).get("steps", []) if x["step"] == "shake polish"] in ([21, 22, 23], []),
+          "stage 5c's summary records the three replications' shake polishes")
     # its design = the best of the re-check (LHS starts of MEAN_GOAL_RECHECK_SEED) within every bound with the %MI margin
     rc = [x for x in mg["steps"] if x["step"] == "re-check"] if mg else []
     check(not mg or rc and any(x["point"] == mg["point"] and x["within"] and x["pct_mi"] <= study.MEAN_GOAL_RECHECK_MI
@@ -442,6 +445,20 @@ def end_to_end(abuopt, tmp):
     computed = [l for l in r2.stdout.splitlines() if "(computed)" in l or l.startswith("[validation]")]
     check(r2.returncode == 0 and not computed and "(archive)" in r2.stdout,
           f"the rerun replays every evaluation and keeps every validation ({len(computed)} recomputed)")
+    # the stop rule: with a stop value over every mean the first replication's design ends stage 5c (when it has one),
+    # replayed from its archives, the other replications not run
+    steps = (json.load(open(os.path.join(out, "summary.json")))["mean_goal"] or {}).get("steps", [])
+    rep1 = [x for x in steps if x["step"] == "re-check" and "_rep" not in x["point"] and x["within"]]
+    r3 = subprocess.run(cmd[:-1] + ["1000"], capture_output=True, text=True)
+    mg3 = json.load(open(os.path.join(out, "summary.json")))["mean_goal"] if r3.returncode == 0 else {}
+    computed = [l for l in r3.stdout.splitlines() if "(computed)" in l or l.startswith("[validation] mean_goal")]
+    best1 = min(rep1, key=lambda x: x["in_sample"]) if rep1 else None
+    check(r3.returncode == 0 and not computed and (
+        best1 is None or "the other 2 replication(s) are not run" in r3.stdout and mg3["point"] == best1["point"]
+        and [x["seed"] for x in mg3["steps"] if x["step"] == "shake polish"] == [21]
+        and not any("_rep" in x.get("point", "") for x in mg3["steps"])),
+          f"--mean-goal-stop 1000: stage 5c ends with the first replication's design "
+          f"({best1['point'] if best1 else 'none within the bounds at this scale'}), replayed")
 
 
 def main():
