@@ -276,8 +276,9 @@ def mean_goal(abuopt, tmp, cdir):
 
 def end_to_end(abuopt, tmp):
     out = os.path.join(tmp, "study")
-    cmd = [sys.executable, SCRIPT, "--abuopt", abuopt, "--out", out, "--scale", "0.02", "--val-runs", "8",
-           "--threads", "2", "--nice", "0", "--shake-balls", "3", "--mean-goal-stop", "0"]  # 5c: every replication
+    base = [sys.executable, SCRIPT, "--abuopt", abuopt, "--out", out, "--scale", "0.02", "--val-runs", "8",
+            "--threads", "2", "--nice", "0", "--shake-balls", "3"]
+    cmd = base + ["--mean-goal-stop", "0"]  # stage 5c: every replication
     r = subprocess.run(cmd, capture_output=True, text=True)
     check(r.returncode == 0, f"the study runs end to end (status {r.returncode}) {r.stderr[-2000:]}")
     if r.returncode != 0:
@@ -400,17 +401,25 @@ def end_to_end(abuopt, tmp):
     # the replications (MEAN_GOAL_REPLICATIONS, the default 3; --mean-goal-stop 0 runs every one): the same chain on the
     # LHS starts of seeds 22 and 23, each its shake polish, its scan (the same points, suffixed _rep<k>) and its deep
     # polish in folders of their own
+    possible = {"mean_goal_shaken"} | {f"mean_goal_deep{b:g}Hz_at{o:g}s" for o in study.MEAN_GOAL_OFFSETS_S
+                                       for b in study.MEAN_GOAL_BOTTOMS_HZ}
     for k in range(2, study.MEAN_GOAL_REPLICATIONS + 1):
-        repk = sorted(x for x in scan5c if x.endswith(f"_rep{k}"))
-        wantk = sorted(x + f"_rep{k}" for x in scan5c if "_rep" not in x and "recheck" not in x)
+        names_k = {x[:-len(f"_rep{k}")] for x in scan5c if x.endswith(f"_rep{k}")}  # its scan (not its re-checks)
         shk = os.path.join(out, f"f1_mu02_shake_6balls_rep{k}", "config.yaml")
-        check(study.MEAN_GOAL_REPLICATIONS == 3 and repk == wantk and os.path.exists(shk)
+        tag = f"[mean goal, replication {k} (seed {20 + k})]"
+        polished = os.path.isdir(os.path.join(out, f"f1_mu02_deep_6balls_rep{k}"))
+        check(study.MEAN_GOAL_REPLICATIONS == 3 and "mean_goal_shaken" in names_k and names_k <= possible
+              and npoints - 3 <= len(names_k) <= npoints and os.path.exists(shk)
               and re.search(rf"^  seed: {20 + k}\b", study.read(shk), re.M)
               and f"# runs 5 seed {20 + k} --mu 0.02 design lhs" in study.read(
-                  os.path.join(out, "validation", f"mean_goal_shaken_rep{k}", "config.yaml")),
-              f"stage 5c's replication {k}: {len(repk)} scan points on seed {20 + k}'s starts, its own shake polish")
-    check([x["seed"] for x in (s["mean_goal"] or {}).get("steps", []) if x["step"] == "shake polish"] in ([21, 22, 23], []),
-          "stage 5c's summary records the three replications' shake polishes")
+                  os.path.join(out, "validation", f"mean_goal_shaken_rep{k}", "config.yaml"))
+              and f"{tag} up-shake polished" in r.stdout and polished == (f"{tag} deep polish 1 from" in r.stdout),
+              f"stage 5c's replication {k}: {len(names_k)} scan points on seed {20 + k}'s starts, its own shake polish"
+              f"{', its own deep polish' if polished else ''}")
+    check((mg and [x["seed"] for x in mg["steps"] if x["step"] == "shake polish"] == [21, 22, 23]
+           and {x["replication"] for x in mg["steps"] if x["step"] == "re-check"} <= {1, 2, 3})
+          or not mg and "[mean goal, replication 3 (seed 23)] up-shake polished" in r.stdout,
+          "stage 5c ran the three replications (its summary records their shake polishes)")
     # its design = the best of the re-check (LHS starts of MEAN_GOAL_RECHECK_SEED) within every bound with the %MI margin
     rc = [x for x in mg["steps"] if x["step"] == "re-check"] if mg else []
     check(not mg or rc and any(x["point"] == mg["point"] and x["within"] and x["pct_mi"] <= study.MEAN_GOAL_RECHECK_MI
@@ -448,13 +457,14 @@ def end_to_end(abuopt, tmp):
     # the stop rule: with a stop value over every mean the first replication's design ends stage 5c (when it has one),
     # replayed from its archives, the other replications not run
     steps = (json.load(open(os.path.join(out, "summary.json")))["mean_goal"] or {}).get("steps", [])
-    rep1 = [x for x in steps if x["step"] == "re-check" and "_rep" not in x["point"] and x["within"]]
-    r3 = subprocess.run(cmd[:-1] + ["1000"], capture_output=True, text=True)
+    rep1 = [x for x in steps if x["step"] == "re-check" and x["replication"] == 1 and x["within"]]
+    r3 = subprocess.run(base + ["--mean-goal-stop", "1000"], capture_output=True, text=True)
     mg3 = json.load(open(os.path.join(out, "summary.json")))["mean_goal"] if r3.returncode == 0 else {}
     computed = [l for l in r3.stdout.splitlines() if "(computed)" in l or l.startswith("[validation] mean_goal")]
     best1 = min(rep1, key=lambda x: x["in_sample"]) if rep1 else None
     check(r3.returncode == 0 and not computed and (
-        best1 is None or "the other 2 replication(s) are not run" in r3.stdout and mg3["point"] == best1["point"]
+        best1 is None and "not run" not in r3.stdout and "[mean goal, replication 3 (seed 23)]" in r3.stdout
+        or best1 is not None and "the other 2 replication(s) are not run" in r3.stdout and mg3["point"] == best1["point"]
         and [x["seed"] for x in mg3["steps"] if x["step"] == "shake polish"] == [21]
         and not any("_rep" in x.get("point", "") for x in mg3["steps"])),
           f"--mean-goal-stop 1000: stage 5c ends with the first replication's design "
