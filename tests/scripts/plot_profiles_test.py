@@ -43,7 +43,7 @@ def main():
         cfg = os.path.join(tmp, "design.yaml")
         with open(cfg, "w") as f:
             f.write(CONFIG)
-        best = os.path.join(ROOT, "configs", "studies", "best", "contact_best_mu03_deepshake_6balls.yaml")
+        best = os.path.join(ROOT, "configs", "designs", "mu03_6balls_17s.yaml")
         r = subprocess.run([sys.executable, SCRIPT, cfg, best, "--out", os.path.join(tmp, "out")],
                            capture_output=True, text=True)
         dat = os.path.join(tmp, "out", "profiles.dat")
