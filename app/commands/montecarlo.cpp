@@ -200,10 +200,10 @@ int run_montecarlo(const MonteCarloArgs& a) {
   if (!a.out.empty()) {
     // The title names the config and its profile (segments: end frequency in duration), then the sample.
     std::ostringstream what;
-    what << std::filesystem::path(a.config).stem().string() << ", profile " << format_number(s.setup.profile.start_frequency_hz());
+    what << "profile " << format_number(s.setup.profile.start_frequency_hz());
     for (const auto& seg : s.setup.profile.segments())
       what << " → " << format_number(seg.end_frequency_hz) << " Hz in " << format_number(seg.duration_s) << " s";
-    what << "|" << to_string(study_design(s).kind) << " design, seed " << s.seed << ", μ = " << friction_text(s);
+    what << "|" << std::filesystem::path(a.config).stem().string() << ": " << to_string(study_design(s).kind) << " design, seed " << s.seed << ", μ = " << friction_text(s);
     plot = write_outputs(a.out, result, summary, s.setup.abu.imbalance_kgm(), what.str());
   }
 

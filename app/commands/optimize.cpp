@@ -187,7 +187,7 @@ PlotStatus write_convergence(const fs::path& dir, const opt::OptimizationResult&
   b << "set datafile separator ','\n"
     << "set title " << plot_style::literal("Convergence of " + r.algorithm + " on " + r.problem_name) << "\n"
     << "set xlabel 'evaluation'\nset ylabel " << plot_style::literal("objective: " + ylabel) << "\n"
-    << "set key below box opaque\nset grid\n";
+    << "set key at screen 0.5, 0.02 center bottom horizontal maxrows 2 box opaque\nset bmargin 7\nset grid\n";
   if (any_violation)
     b << "set y2label 'largest constraint violation (relative; infeasible points)'\nset logscale y2\n"
          "set y2tics nomirror\nset ytics nomirror\n";
