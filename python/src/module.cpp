@@ -335,8 +335,9 @@ PYBIND11_MODULE(abuopt, m) {
            "failed), metrics (dict), ok, message. The last x is remembered (no second Monte Carlo).\n"
            "Units: the optimiser's numbers, as `abuopt optimize` prints and archives them (mean I_r in\n"
            "1e-7 kg m, %MI in %; docs/optimize.md); x in Hz and s.")
-      .def_property_readonly("names", &PyStartupProfileProblem::names)
-      .def_property_readonly("bounds", &PyStartupProfileProblem::bounds, "[(lower, upper)] per variable")
+      .def_property_readonly("names", &PyStartupProfileProblem::names,
+                             "variable names: f<k> end frequency of segment k [Hz], dt<k> its duration [s]")
+      .def_property_readonly("bounds", &PyStartupProfileProblem::bounds, "[(lower, upper)] per variable (Hz and s)")
       .def_property_readonly("scales", [](const PyStartupProfileProblem& p) {
         const std::vector<double> x = p.scales();
         return Array(static_cast<py::ssize_t>(x.size()), x.data());
