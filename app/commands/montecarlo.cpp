@@ -138,7 +138,7 @@ PlotStatus plot_residual_histogram(const std::string& dir, const MonteCarloResul
     // `what`: "<config>, profile ...|<design>": the title names the profile, a label the sample
     << "set title " << plot_style::literal("Residual imbalance of " + std::to_string(ok) + " runs: " + what.substr(0, what.find('|')))
     << "\nset label 2 " << plot_style::literal(what.find('|') == std::string::npos ? std::string() : what.substr(what.find('|') + 1))
-    << " at graph 0.98, graph 0.95 right front\n"
+    << " at graph 0.98, graph 0.95 right front boxed\nset style textbox opaque noborder fillcolor rgb '#ffffff'\n"
     << "set xlabel 'residual imbalance [10^{-7} kg m]'\nset ylabel 'runs per bin'\n"
     << "ir(c) = (strcol('status') eq 'ok') ? column(c) * 1e7 : NaN\n"
     << "stats 'runs.csv' using (ir('ir_magnitude_kgm')) nooutput\n"
