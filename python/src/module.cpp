@@ -13,6 +13,7 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/config_sections.hpp"
+#include "bindings.hpp"  // register_module_extras, register_archive
 #include "abuopt/core/batch_runner.hpp"
 #include "abuopt/core/equilibrium_set.hpp"
 #include "abuopt/core/monte_carlo.hpp"
@@ -21,7 +22,6 @@
 #include "abuopt/core/simulator.hpp"
 #include "abuopt/optimizer/optimizer_options.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
-#include "bindings.hpp"
 #include "convert.hpp"
 
 namespace py = pybind11;
@@ -299,6 +299,7 @@ PYBIND11_MODULE(abuopt, m) {
       "archive's values are the optimiser's numbers, as `abuopt optimize` prints them (mean I_r in\n"
       "1e-7 kg m; docs/optimize.md). Per-run results are NumPy arrays.";
   py::register_exception<abuopt::ConfigError>(m, "ConfigError", PyExc_ValueError);
+  register_archive(m);  // abuopt.Archive (archive_bindings.cpp)
 
   m.def("simulate", &simulate, py::arg("config"), py::kw_only(), py::arg("beta0"),
         "One startup from the initial ball angles beta0 [rad] (one per ball), as `abuopt simulate`.\n"
@@ -351,5 +352,4 @@ PYBIND11_MODULE(abuopt, m) {
       .def_property_readonly("evaluations", &PyStartupProfileProblem::evaluations,
                              "Monte Carlo evaluations done (repeats of the last x not counted)")
       .def("startup_time_s", &PyStartupProfileProblem::startup_time_s, py::arg("x"));
-  register_archive(m);
 }
