@@ -61,14 +61,15 @@ TEST(UsabilityCli, ProgressOnlyWhenAskedOffATerminal) {
 // A config that serves several commands is accepted by each (eqset ignores the montecarlo section);
 // a misspelt section is still refused, its value shown briefly, not as the whole section.
 TEST(UsabilityCli, EqsetReadsAMonteCarloConfig) {
-  const auto r = run_abuopt("eqset " + kConfigs + "montecarlo_final_profile.yaml --freq 29 --grid 16");
+  const std::string out = std::string(ABUOPT_BINARY_DIR) + "/usability_eqset";
+  const auto r = run_abuopt("eqset " + kConfigs + "montecarlo_final_profile.yaml --freq 29 --grid 16 --out " + out);
   EXPECT_EQ(r.status, 0) << r.output;
   const std::string path = std::string(ABUOPT_BINARY_DIR) + "/usability_section.yaml";
   std::ifstream in(kConfigs + "montecarlo_final_profile.yaml");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   text.replace(text.find("montecarlo:"), 11, "montecalro:");
   std::ofstream(path) << text;
-  const auto bad = run_abuopt("eqset " + path + " --freq 29 --grid 16");
+  const auto bad = run_abuopt("eqset " + path + " --freq 29 --grid 16 --out " + out);
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.output.find("montecalro = {design: grid, grid: 32, runs: 1024, seed: 1, threads: 0, ...}: unknown key "
                             "(misspelt, or not valid here); did you mean 'montecarlo'?"),
