@@ -17,6 +17,7 @@ packages=(
   libgtest-dev           # tests
   libbenchmark-dev       # bench/
   gnuplot-nox            # plots (optional at run time: studies skip plots without it)
+  doxygen                # the optional API reference target `doc` (cmake/AbuoptData.cmake)
   clang libclang-rt-14-dev  # libFuzzer targets (fuzz/, scripts/fuzz.sh) with ASan/UBSan runtimes
   python3                # scripts/startup_study.py, scripts/final_states_in_set.py (standard library only)
   python3-dev pybind11-dev python3-numpy  # the Python module abuopt (python/; skipped without them)
