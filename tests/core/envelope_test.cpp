@@ -226,6 +226,44 @@ TEST(EnvelopeSimulator, AnOverrideEqualsTheNominalRunWithThatValue) {
   }
 }
 
+TEST(EnvelopeSimulator, RunsWithTheirOwnOscillatorStayOnTheExactPath) {
+  // A stiffness or imbalance-mass override gives the run another omega_n and bbar than the
+  // Simulator's table: it takes the per-run view of the shared profile samples
+  // (run_forcing_table.hpp), not the Runge-Kutta stuck phases. Against a Simulator built with those
+  // values (its own exact table on a slightly different grid): the same final angles to 1e-9 and about
+  // the same work (steps: grid intervals + stepper steps, within 5 %; the Runge-Kutta path takes
+  // several times the right-hand-side evaluations).
+  MonteCarloStudy s = envelope_study(6);
+  s.setup.profile = StartupProfile({{25.0, 1.0}, {29.5, 3.0}, {60.0, 2.0}});
+  const Simulator sim(s.setup);
+  SimulationSetup rk_setup = s.setup;
+  rk_setup.options.stuck_integrator = StuckIntegrator::RungeKutta;
+  const Simulator rk(rk_setup);
+  long steps_view = 0, steps_nominal = 0, rhs_view = 0, rhs_rk = 0;
+  for (std::size_t i = 0; i < 6; ++i) {
+    const MonteCarloSample smp = prepare_sample(s, i);
+    SimulationSetup at = s.setup;
+    at.abu.friction_mu = smp.friction_mu;
+    at.abu.imbalance_mass_kg = *smp.overrides.imbalance_mass_kg;
+    at.abu.stiffness_N_per_m = smp.stiffness_N_per_m;
+    at.abu.ball_restitution = smp.restitution;
+    const RunOutcome a = sim.run(smp.beta0, smp.overrides);
+    const RunOutcome b = Simulator(at).run(smp.beta0);
+    ASSERT_TRUE(a.ok() && b.ok()) << a.message << b.message;
+    for (std::size_t k = 0; k < 2; ++k)
+      EXPECT_NEAR(std::remainder(a.beta_final[k] - b.beta_final[k], 2 * M_PI), 0.0, 1e-9) << "run " << i;
+    // the peak amplitude is taken at the grid points passed, and the grids differ
+    EXPECT_NEAR(a.max_amplitude_mm, b.max_amplitude_mm, 1e-4 * b.max_amplitude_mm) << "run " << i;
+    EXPECT_EQ(a.events, b.events) << "run " << i;
+    steps_view += a.steps;
+    steps_nominal += b.steps;
+    rhs_view += a.rhs_evaluations;
+    rhs_rk += rk.run(smp.beta0, smp.overrides).rhs_evaluations;
+  }
+  EXPECT_NEAR(static_cast<double>(steps_view) / static_cast<double>(steps_nominal), 1.0, 0.05);
+  EXPECT_LT(2 * rhs_view, rhs_rk);
+}
+
 TEST(EnvelopeSimulator, StiffnessMovesTheResonance) {
   // Balls held by friction (mu 0.9): the table is a forced oscillator. On a slow ramp (25 -> 35 Hz
   // in 40 s, at most 0.5 Hz/s) its amplitude peaks just after the natural frequency (within
