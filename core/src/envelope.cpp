@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/core/initial_conditions.hpp"
 
 namespace abuopt {
 
@@ -58,7 +59,44 @@ void describe_parameter(FieldArchive& a, const char* key, ParameterDistribution&
   }
 }
 
+std::uint32_t reverse_bits(std::uint32_t x) {
+  x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
+  x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
+  x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
+  x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
+  return (x >> 16) | (x << 16);
+}
+
+// Nested uniform (Owen) scrambling of x's bits: a hash that only mixes lower bits into higher ones
+// (Laine and Karras) applied to the bit-reversed value (Burley, "Practical hash-based Owen
+// scrambling", JCGT 9(4), 2020), so that each bit is flipped by a function of the bits above it.
+std::uint32_t owen_scramble(std::uint32_t x, std::uint32_t seed) {
+  x = reverse_bits(x);
+  x += seed;
+  x ^= x * 0x6c50b47cu;
+  x ^= x * 0xb82f1e52u;
+  x ^= x * 0xc7afe638u;
+  x ^= x * 0x8d22f6e6u;
+  return reverse_bits(x);
+}
+
+constexpr std::uint64_t kTagScramble = 0x534352414d424c45ULL;  // "SCRAMBLE"
+constexpr std::uint64_t kTagLowBits = 0x4c4f57424954534eULL;   // "LOWBITSN"
+
 }  // namespace
+
+const EnumNames<EnvelopeSampling> kEnvelopeSamplingNames = {{EnvelopeSampling::Random, "random"},
+                                                             {EnvelopeSampling::Sobol, "sobol"}};
+
+double joint_sobol_coordinate(std::uint64_t seed, std::size_t index, std::size_t dim) {
+  const std::size_t r = index % Envelope::kReplicates, k = index / Envelope::kReplicates;
+  const double u = sobol_unit_point(k, dim + 1)[dim];
+  const auto x = static_cast<std::uint32_t>(u * 4294967296.0);  // the sequence's 32 bits, exactly
+  const auto scramble = static_cast<std::uint32_t>(hash_seed(seed, kTagScramble, r * 64 + dim));
+  // below the 32 scrambled bits, uniform ones (what a full-depth scrambling gives)
+  const double low = unit_double(hash_seed(seed ^ kTagLowBits, index, dim));
+  return (static_cast<double>(owen_scramble(x, scramble)) + low) / 4294967296.0;
+}
 
 std::string to_string(DistributionKind k) {
   switch (k) {
@@ -143,6 +181,7 @@ void validate(const Envelope& e, const std::string& path) {
 
 void describe_fields(FieldArchive& a, Envelope& e) {
   for (std::size_t k = 0; k < Envelope::kParameters; ++k) describe_parameter(a, Envelope::key(k), e.parameter(k));
+  a.field("sampling", e.sampling, kEnvelopeSamplingNames);
 }
 
 Envelope read_envelope(YamlReader& root) {

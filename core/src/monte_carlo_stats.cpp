@@ -263,6 +263,46 @@ std::string format_summary(const MonteCarloStats& s) {
   return os.str();
 }
 
+double mean_half_width95(const std::vector<MonteCarloSample>& samples, std::size_t replicates, bool report_x) {
+  auto value = [&](const MonteCarloSample& s) {
+    return report_x ? s.outcome.residual_imbalance_x_kgm : s.outcome.residual_imbalance_kgm;
+  };
+  auto mean_var = [](const std::vector<double>& v, double& m, double& var) {
+    m = 0;
+    for (double x : v) m += x;
+    m /= static_cast<double>(v.size());
+    var = 0;
+    for (double x : v) var += (x - m) * (x - m);
+    var /= static_cast<double>(v.size() - 1);
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (replicates <= 1) {
+    std::vector<double> v;
+    for (const auto& s : samples)
+      if (s.outcome.ok()) v.push_back(value(s));
+    if (v.size() < 2) return nan;
+    double m, var;
+    mean_var(v, m, var);
+    return 1.96 * std::sqrt(var / static_cast<double>(v.size()));
+  }
+  std::vector<double> sum(replicates, 0.0), count(replicates, 0.0);
+  for (const auto& s : samples)
+    if (s.outcome.ok()) {
+      sum[s.index % replicates] += value(s);
+      count[s.index % replicates] += 1;
+    }
+  std::vector<double> means;
+  for (std::size_t r = 0; r < replicates; ++r)
+    if (count[r] > 0) means.push_back(sum[r] / count[r]);
+  if (means.size() < 2) return nan;
+  double m, var;
+  mean_var(means, m, var);
+  // t quantile 0.975 with nu degrees of freedom (Cornish-Fisher; 2.131 for nu = 15, within 1e-3)
+  const double nu = static_cast<double>(means.size() - 1), z = 1.959964;
+  const double t = z + (z * z * z + z) / (4 * nu) + (5 * std::pow(z, 5) + 16 * z * z * z + 3 * z) / (96 * nu * nu);
+  return t * std::sqrt(var / static_cast<double>(means.size()));
+}
+
 void write_runs_csv(std::ostream& os, const std::vector<MonteCarloSample>& samples) {
   std::size_t n = 0;
   for (const auto& s : samples) n = std::max({n, s.beta0.size(), s.outcome.beta_final.size()});

@@ -120,7 +120,9 @@ RunOverrides sample_overrides(const UncertainParameters& u, const AbuParameters&
   const Envelope& e = u.envelope;
   auto draw = [&](std::size_t k) {
     const ParameterDistribution& d = e.parameter(k);
-    return d.at(d.varies() ? unit_double(hash_seed(seed, envelope_tag(k), index)) : 0.0);
+    if (!d.varies()) return d.at(0.0);
+    return d.at(e.sampling == EnvelopeSampling::Sobol ? joint_sobol_coordinate(seed, index, k)
+                                                      : unit_double(hash_seed(seed, envelope_tag(k), index)));
   };
   if (e.friction_mu.given()) o.friction_mu = draw(0);
   if (e.imbalance_mass_factor.given()) o.imbalance_mass_kg = nominal.imbalance_mass_kg * draw(1);

@@ -11,7 +11,9 @@
 #include <string>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/core/ball_contact.hpp"
 #include "abuopt/core/monte_carlo.hpp"
+#include "abuopt/core/monte_carlo_stats.hpp"
 #include "abuopt/core/simulator.hpp"
 
 namespace abuopt {
@@ -152,9 +154,10 @@ TEST(EnvelopeDraws, LieInRangeAndMatchUniformMeanAndVariance) {
 }
 
 TEST(EnvelopeDraws, UseTheStreamsOfTheOldKeys) {
-  // envelope friction U[a, b] == montecarlo.friction.range [a, b]; imbalance factor U[1 + lo, 1 + hi]
+  // sampling random: envelope friction U[a, b] == montecarlo.friction.range [a, b]; imbalance factor U[1 + lo, 1 + hi]
   // == mass_relative_range [lo, hi] (to rounding): shipped configs keep their draws.
   MonteCarloStudy old_keys = envelope_study(64), env = envelope_study(64);
+  env.uncertain.envelope.sampling = EnvelopeSampling::Random;
   old_keys.uncertain.envelope = Envelope{};
   old_keys.uncertain.friction.sampling = FrictionSampling::Range;
   old_keys.uncertain.friction.lo = 0.02;
@@ -169,6 +172,53 @@ TEST(EnvelopeDraws, UseTheStreamsOfTheOldKeys) {
     EXPECT_NEAR(*a.imbalance_mass_kg, *b.imbalance_mass_kg, 1e-15 * *a.imbalance_mass_kg);
     EXPECT_FALSE(a.stiffness_N_per_m.has_value());
   }
+}
+
+TEST(EnvelopeDraws, SobolSamplingStratifiesEveryReplicateAndGivesTheAngles) {
+  // Each of the 16 scramblings is a (t, m, s)-net in base 2 before and after Owen scrambling: its
+  // first 16 points put every coordinate (4 parameters, 6 angles) once into each sixteenth.
+  for (std::size_t r = 0; r < Envelope::kReplicates; ++r)
+    for (std::size_t dim = 0; dim < 10; ++dim) {
+      std::vector<int> hits(16, 0);
+      for (std::size_t k = 0; k < 16; ++k) {
+        const double u = joint_sobol_coordinate(7, k * Envelope::kReplicates + r, dim);
+        ASSERT_GE(u, 0.0);
+        ASSERT_LT(u, 1.0);
+        ++hits[static_cast<std::size_t>(u * 16)];
+      }
+      EXPECT_EQ(*std::min_element(hits.begin(), hits.end()), 1) << "replicate " << r << " dim " << dim;
+    }
+  // Design random: the start angles are the joint point's (coordinates 4, 5), mapped onto the
+  // contact-feasible set; design lhs: the design's, and the parameters stay joint.
+  MonteCarloStudy s = envelope_study(64);
+  EXPECT_TRUE(joint_sampling(s));
+  const MonteCarloSample smp = prepare_sample(s, 5);
+  std::vector<double> raw = {2 * M_PI * joint_sobol_coordinate(7, 5, 4), 2 * M_PI * joint_sobol_coordinate(7, 5, 5)};
+  EXPECT_EQ(smp.beta0, map_onto_contact_feasible_set(s.setup.abu, raw));
+  EXPECT_NEAR(*smp.overrides.stiffness_N_per_m,
+              s.setup.abu.stiffness_N_per_m * (0.95 + 0.1 * joint_sobol_coordinate(7, 5, 2)), 1e-9);
+  s.design.kind = InitialConditionKind::LatinHypercube;
+  EXPECT_FALSE(joint_sampling(s));
+  EXPECT_NE(prepare_sample(s, 5).beta0, smp.beta0);
+  s.design.kind = InitialConditionKind::Random;
+  s.uncertain.envelope.sampling = EnvelopeSampling::Random;
+  EXPECT_FALSE(joint_sampling(s));
+}
+
+TEST(EnvelopeDraws, ReplicateIntervalComesFromTheReplicateMeans) {
+  // 32 runs, run i has |I_r| = (i mod 16) 1e-7: the 16 replicate means are 0..15 (sample
+  // variance 340 / 15), half-width t_15 sqrt(340 / 15 / 16) = 2.131 x 1.1902 = 2.536e-7; as
+  // independent runs, 1.96 sqrt(s^2 / 32) with the 32 values' sample variance.
+  std::vector<MonteCarloSample> v(32);
+  for (std::size_t i = 0; i < 32; ++i) {
+    v[i].index = i;
+    v[i].outcome.residual_imbalance_kgm = 1e-7 * static_cast<double>(i % 16);
+  }
+  EXPECT_NEAR(mean_half_width95(v, 16) * 1e7, 2.536, 3e-3);
+  double var = 0;
+  for (std::size_t i = 0; i < 32; ++i) var += std::pow(static_cast<double>(i % 16) - 7.5, 2);
+  var /= 31;
+  EXPECT_NEAR(mean_half_width95(v, 1) * 1e7, 1.96 * std::sqrt(var / 32), 1e-9);
 }
 
 // Cheap stand-in for the simulator that depends on every overridden value.

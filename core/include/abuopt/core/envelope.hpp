@@ -7,10 +7,12 @@
 //     imbalance_mass_factor: {uniform: [0.5, 1.5]}  # x abu.imbalance_mass_kg (e fixed)
 //     stiffness_factor: {uniform: [0.95, 1.05]}     # x abu.stiffness_N_per_m (moves omega_n)
 //     restitution: {uniform: [0.5, 0.95]}           # ball-ball, absolute (hard contact)
+//     sampling: sobol                               # or random (EnvelopeSampling)
 //
 // Each parameter is absent (nominal: the abu section's value), fixed ({fixed: v} or a plain
-// number) or uniform ({uniform: [lo, hi]}). Run i of a study with seed S draws parameter p from
-// u = unit_double(hash_seed(S, tag_p, i)): replayable from (S, i) alone, independent of the thread
+// number) or uniform ({uniform: [lo, hi]}). With sampling: random, run i of a study with seed S
+// draws parameter p from u = unit_double(hash_seed(S, tag_p, i)); with sobol, u is coordinate p
+// of the joint point (joint_sobol_coordinate). Either way: replayable from (S, i) alone, independent of the thread
 // count, of the ranks and of which other parameters are uncertain. Friction and imbalance mass use
 // the streams of montecarlo.friction.range / montecarlo.imbalance.mass_relative_range, so an
 // envelope uniform equals the old key's range draw for draw.
@@ -24,6 +26,12 @@
 namespace abuopt {
 
 enum class DistributionKind { Nominal, Fixed, Uniform };
+// How the varying parameters (and, with montecarlo.design random or sobol, the start angles) are
+// drawn: Sobol (default): one joint scrambled Sobol' point per run (randomised QMC, 16 interleaved
+// independent scramblings: a narrower interval for the same runs, docs/montecarlo.md); Random:
+// each parameter from its own hashed stream (the old keys' draws).
+enum class EnvelopeSampling { Random, Sobol };
+extern const EnumNames<EnvelopeSampling> kEnvelopeSamplingNames;  // random, sobol
 std::string to_string(DistributionKind k);
 
 // One uncertain parameter: nominal (absent), fixed at lo (== hi), or uniform in [lo, hi].
@@ -48,6 +56,12 @@ struct Envelope {
   ParameterDistribution imbalance_mass_factor;  // x abu.imbalance_mass_kg
   ParameterDistribution stiffness_factor;       // x abu.stiffness_N_per_m
   ParameterDistribution restitution;            // absolute ball-ball restitution
+  EnvelopeSampling sampling = EnvelopeSampling::Sobol;
+  // Scrambled Sobol': run i is point i / kReplicates of scrambling i mod kReplicates.
+  static constexpr std::size_t kReplicates = 16;
+  // Joint coordinates: the kParameters parameters first, then the start angles (at most
+  // kMaxJointBalls balls: the Sobol' directions shipped cover 10 dimensions).
+  static constexpr std::size_t kMaxJointBalls = 6;
 
   // Number of parameters in the section, the names of the keys, and access by position (the
   // order of the keys above).
@@ -71,6 +85,11 @@ inline constexpr std::uint64_t kTagMass = 0x494d42414c4d4153ULL;         // "IMB
 inline constexpr std::uint64_t kTagStiffness = 0x53544946464e4553ULL;    // "STIFFNES"
 inline constexpr std::uint64_t kTagRestitution = 0x5245535449545554ULL;  // "RESTITUT"
 std::uint64_t envelope_tag(std::size_t k);  // the tag of parameter k (Envelope::key order)
+
+// Coordinate `dim` of run `index`'s joint point in [0, 1) (scrambled Sobol': Owen's nested
+// uniform scrambling by hashing, Burley 2020, seeded by (seed, replicate, dim)); dim < 10. A pure
+// function of its arguments.
+double joint_sobol_coordinate(std::uint64_t seed, std::size_t index, std::size_t dim);
 
 // Throws ConfigError (keys below `path`, e.g. "envelope.stiffness_factor.uniform") for lo > hi,
 // non-finite values, mu outside [0, 1), factors <= 0, restitution outside [0, 1].

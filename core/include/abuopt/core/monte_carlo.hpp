@@ -4,6 +4,7 @@
 // Run i of a study is a pure function of (study, i):
 //   beta0     = point i of the initial-condition design (initial_conditions.hpp),
 //   overrides = sample_overrides(study.uncertain, setup.abu, study.seed, i) (hash of (seed, i)),
+//   (with the envelope's joint sampling, beta0 and the overrides are one scrambled Sobol' point),
 //   outcome   = the per-sample function (by default Simulator::run) of (beta0, overrides).
 // The engine writes outcome i into slot i of a pre-sized vector, whatever worker ran it, so the
 // results are bit-identical for any thread count or batch backend, and run_one(study, i) replays
@@ -46,6 +47,12 @@ struct MonteCarloStudy {
 
 // True when the setup's balls are all identical (same mass and diameter), i.e. exchangeable.
 bool balls_exchangeable(const SimulationSetup& setup);
+
+// True when run i's start angles come from the envelope's joint scrambled Sobol' point (not the
+// design): envelope.sampling sobol, a varying envelope parameter, and design random or sobol.
+// Then the runs form Envelope::kReplicates independent scramblings (run i in i mod 16), and
+// mean_interval95 (monte_carlo_stats.hpp) takes the interval from their means.
+bool joint_sampling(const MonteCarloStudy& s);
 
 // The design the study actually uses: `design` with balls = setup.abu.balls.size() and, unless it
 // is a grid, count = runs.
