@@ -198,11 +198,15 @@ int run_montecarlo(const MonteCarloArgs& a) {
   nlohmann::json summary = to_json(stats);
   summary["study"] = study_json(a, cfg, end_time_s);
   // the interval of the mean: from the replicate means under the envelope's scrambled Sobol' draws
-  const std::size_t replicates = joint_sampling(s) ? Envelope::kReplicates : 1;
-  const double hw = mean_half_width95(result.samples, replicates), hw_x = mean_half_width95(result.samples, replicates, true);
+  const IntervalLayout layout = interval_layout(s);
+  const double hw = mean_half_width95(result.samples, layout), hw_x = mean_half_width95(result.samples, layout, true);
+  const std::string interval_text =
+      layout.kind == IntervalKind::Replicates ? "from the means of 16 scrambled Sobol' replicates"
+      : layout.kind == IntervalKind::Strata   ? "stratified: " + std::to_string(layout.groups) + " cells of the envelope"
+                                              : "independent runs";
   summary["magnitude"]["mean_ci95_half_width"] = hw;
   summary["report_x"]["mean_ci95_half_width"] = hw_x;
-  summary["study"]["mean_interval"] = replicates > 1 ? "16 scrambled Sobol' replicates (t interval)" : "independent runs";
+  summary["study"]["mean_interval"] = interval_text;
   const Provenance prov = provenance_of(a.config);
   summary["provenance"] = {{"abuopt_version", prov.abuopt_version},
                            {"git_commit", prov.git_commit},
@@ -231,14 +235,12 @@ int run_montecarlo(const MonteCarloArgs& a) {
       std::cout << "  envelope (drawn per run):";
       for (std::size_t k = 0; k < Envelope::kParameters; ++k)
         if (e.parameter(k).given()) std::cout << " " << Envelope::key(k) << " " << e.parameter(k).text() << ";";
-      std::cout << "  sampling " << enum_name(kEnvelopeSamplingNames, e.sampling)
-                << (replicates > 1 ? " (joint with the start angles; 16 independent scramblings)" : "") << "\n";
+      std::cout << "  sampling " << enum_name(kEnvelopeSamplingNames, e.sampling) << "\n";
     }
     std::cout << std::setprecision(6) << format_summary(stats);
     if (!e.empty())
       std::cout << "95 % interval of the mean: |I_r| +- " << std::setprecision(3) << hw * 1e7 << ", I_r,x +- "
-                << hw_x * 1e7 << " [1e-7 kg m] ("
-                << (replicates > 1 ? "from the means of 16 scrambled Sobol' replicates" : "independent runs") << ")\n"
+                << hw_x * 1e7 << " [1e-7 kg m] (" << interval_text << ")\n"
                 << std::setprecision(6);
     std::cout << terms_text("");
     if (!a.out.empty())

@@ -85,8 +85,16 @@ constexpr std::uint64_t kTagLowBits = 0x4c4f57424954534eULL;   // "LOWBITSN"
 
 }  // namespace
 
-const EnumNames<EnvelopeSampling> kEnvelopeSamplingNames = {{EnvelopeSampling::Random, "random"},
-                                                             {EnvelopeSampling::Sobol, "sobol"}};
+const EnumNames<EnvelopeSampling> kEnvelopeSamplingNames = {
+    {EnvelopeSampling::Random, "random"}, {EnvelopeSampling::Stratified, "stratified"}, {EnvelopeSampling::Sobol, "sobol"}};
+
+std::size_t Envelope::strata() const {
+  if (sampling != EnvelopeSampling::Stratified) return 1;
+  std::size_t cells = 1;
+  for (std::size_t k = 0; k < kParameters; ++k)
+    if (parameter(k).varies()) cells *= 2;
+  return cells;
+}
 
 double joint_sobol_coordinate(std::uint64_t seed, std::size_t index, std::size_t dim) {
   const std::size_t r = index % Envelope::kReplicates, k = index / Envelope::kReplicates;

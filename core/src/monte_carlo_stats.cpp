@@ -263,40 +263,44 @@ std::string format_summary(const MonteCarloStats& s) {
   return os.str();
 }
 
-double mean_half_width95(const std::vector<MonteCarloSample>& samples, std::size_t replicates, bool report_x) {
-  auto value = [&](const MonteCarloSample& s) {
-    return report_x ? s.outcome.residual_imbalance_x_kgm : s.outcome.residual_imbalance_kgm;
-  };
-  auto mean_var = [](const std::vector<double>& v, double& m, double& var) {
-    m = 0;
-    for (double x : v) m += x;
-    m /= static_cast<double>(v.size());
-    var = 0;
-    for (double x : v) var += (x - m) * (x - m);
-    var /= static_cast<double>(v.size() - 1);
-  };
+IntervalLayout interval_layout(const MonteCarloStudy& s) {
+  if (joint_sampling(s)) return {IntervalKind::Replicates, Envelope::kReplicates};
+  const std::size_t h = s.uncertain.envelope.deterministic() ? 1 : s.uncertain.envelope.strata();
+  if (h > 1) return {IntervalKind::Strata, h};
+  return {};
+}
+
+double mean_half_width95(const std::vector<MonteCarloSample>& samples, const IntervalLayout& layout, bool report_x) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  if (replicates <= 1) {
-    std::vector<double> v;
-    for (const auto& s : samples)
-      if (s.outcome.ok()) v.push_back(value(s));
-    if (v.size() < 2) return nan;
-    double m, var;
-    mean_var(v, m, var);
-    return 1.96 * std::sqrt(var / static_cast<double>(v.size()));
+  const std::size_t g = layout.kind == IntervalKind::Independent ? 1 : std::max<std::size_t>(layout.groups, 1);
+  // per group: count, mean and sum of squares (Welford)
+  std::vector<double> n(g, 0.0), mean(g, 0.0), m2(g, 0.0);
+  for (const auto& s : samples) {
+    if (!s.outcome.ok()) continue;
+    const double x = report_x ? s.outcome.residual_imbalance_x_kgm : s.outcome.residual_imbalance_kgm;
+    const std::size_t k = s.index % g;
+    n[k] += 1;
+    const double d = x - mean[k];
+    mean[k] += d / n[k];
+    m2[k] += d * (x - mean[k]);
   }
-  std::vector<double> sum(replicates, 0.0), count(replicates, 0.0);
-  for (const auto& s : samples)
-    if (s.outcome.ok()) {
-      sum[s.index % replicates] += value(s);
-      count[s.index % replicates] += 1;
+  if (layout.kind != IntervalKind::Replicates) {
+    double var = 0;  // of the (stratified) mean, equal weights 1/g
+    for (std::size_t k = 0; k < g; ++k) {
+      if (n[k] < 2) return nan;
+      var += m2[k] / (n[k] - 1) / n[k] / static_cast<double>(g * g);
     }
+    return 1.96 * std::sqrt(var);
+  }
   std::vector<double> means;
-  for (std::size_t r = 0; r < replicates; ++r)
-    if (count[r] > 0) means.push_back(sum[r] / count[r]);
+  for (std::size_t k = 0; k < g; ++k)
+    if (n[k] > 0) means.push_back(mean[k]);
   if (means.size() < 2) return nan;
-  double m, var;
-  mean_var(means, m, var);
+  double m = 0, var = 0;
+  for (double x : means) m += x;
+  m /= static_cast<double>(means.size());
+  for (double x : means) var += (x - m) * (x - m);
+  var /= static_cast<double>(means.size() - 1);
   // t quantile 0.975 with nu degrees of freedom (Cornish-Fisher; 2.131 for nu = 15, within 1e-3)
   const double nu = static_cast<double>(means.size() - 1), z = 1.959964;
   const double t = z + (z * z * z + z) / (4 * nu) + (5 * std::pow(z, 5) + 16 * z * z * z + 3 * z) / (96 * nu * nu);

@@ -116,13 +116,19 @@ RunOverrides sample_overrides(const UncertainParameters& u, const AbuParameters&
     o.imbalance_mass_kg = nominal.imbalance_mass_kg * (1.0 + r);
   }
   // The envelope: each parameter from its own stream (the same streams as the keys above for
-  // friction and imbalance mass, which validate() keeps exclusive).
+  // friction and imbalance mass, which validate() keeps exclusive), folded into its half of the
+  // range by run i's cell (stratified), or the joint scrambled Sobol' point (sobol).
   const Envelope& e = u.envelope;
+  const std::size_t cell = index % e.strata();
   auto draw = [&](std::size_t k) {
     const ParameterDistribution& d = e.parameter(k);
     if (!d.varies()) return d.at(0.0);
-    return d.at(e.sampling == EnvelopeSampling::Sobol ? joint_sobol_coordinate(seed, index, k)
-                                                      : unit_double(hash_seed(seed, envelope_tag(k), index)));
+    if (e.sampling == EnvelopeSampling::Sobol) return d.at(joint_sobol_coordinate(seed, index, k));
+    const double v = unit_double(hash_seed(seed, envelope_tag(k), index));
+    if (e.sampling == EnvelopeSampling::Random) return d.at(v);
+    std::size_t bit = 0;  // this parameter's position among the varying ones: its bit of the cell
+    for (std::size_t q = 0; q < k; ++q) bit += e.parameter(q).varies() ? 1 : 0;
+    return d.at(0.5 * (static_cast<double>((cell >> bit) & 1u) + v));
   };
   if (e.friction_mu.given()) o.friction_mu = draw(0);
   if (e.imbalance_mass_factor.given()) o.imbalance_mass_kg = nominal.imbalance_mass_kg * draw(1);

@@ -191,6 +191,7 @@ TEST(EnvelopeDraws, SobolSamplingStratifiesEveryReplicateAndGivesTheAngles) {
   // Design random: the start angles are the joint point's (coordinates 4, 5), mapped onto the
   // contact-feasible set; design lhs: the design's, and the parameters stay joint.
   MonteCarloStudy s = envelope_study(64);
+  s.uncertain.envelope.sampling = EnvelopeSampling::Sobol;
   EXPECT_TRUE(joint_sampling(s));
   const MonteCarloSample smp = prepare_sample(s, 5);
   std::vector<double> raw = {2 * M_PI * joint_sobol_coordinate(7, 5, 4), 2 * M_PI * joint_sobol_coordinate(7, 5, 5)};
@@ -205,6 +206,32 @@ TEST(EnvelopeDraws, SobolSamplingStratifiesEveryReplicateAndGivesTheAngles) {
   EXPECT_FALSE(joint_sampling(s));
 }
 
+TEST(EnvelopeDraws, StratifiedSamplingPutsEveryRunInItsCell) {
+  // The default: 4 varying parameters, 16 cells; run i lies in cell i mod 16, i.e. parameter q in
+  // the upper half of its range exactly when bit q of (i mod 16) is set; and it is the random
+  // stream's draw folded into that half.
+  const MonteCarloStudy s = envelope_study(256);
+  ASSERT_EQ(s.uncertain.envelope.sampling, EnvelopeSampling::Stratified);
+  EXPECT_EQ(s.uncertain.envelope.strata(), 16u);
+  MonteCarloStudy random = s;
+  random.uncertain.envelope.sampling = EnvelopeSampling::Random;
+  for (std::size_t i = 0; i < 256; ++i) {
+    const RunOverrides o = sample_overrides(s.uncertain, s.setup.abu, s.seed, i);
+    const RunOverrides r = sample_overrides(random.uncertain, s.setup.abu, s.seed, i);
+    const double mu_u = (*o.friction_mu - 0.02) / 0.02, k_u = (*o.stiffness_N_per_m / s.setup.abu.stiffness_N_per_m - 0.95) / 0.1;
+    EXPECT_EQ(mu_u >= 0.5, ((i % 16) & 1u) != 0) << i;
+    EXPECT_EQ(k_u >= 0.5, ((i % 16) & 4u) != 0) << i;
+    EXPECT_NEAR(mu_u, 0.5 * (static_cast<double>(i & 1u) + (*r.friction_mu - 0.02) / 0.02), 1e-12);
+  }
+  // only two varying parameters: 4 cells
+  MonteCarloStudy two = s;
+  two.uncertain.envelope.imbalance_mass_factor = ParameterDistribution::fixed(1.0);
+  two.uncertain.envelope.restitution = ParameterDistribution{};
+  EXPECT_EQ(two.uncertain.envelope.strata(), 4u);
+  EXPECT_EQ(interval_layout(two).kind, IntervalKind::Strata);
+  EXPECT_EQ(interval_layout(two).groups, 4u);
+}
+
 TEST(EnvelopeDraws, ReplicateIntervalComesFromTheReplicateMeans) {
   // 32 runs, run i has |I_r| = (i mod 16) 1e-7: the 16 replicate means are 0..15 (sample
   // variance 340 / 15), half-width t_15 sqrt(340 / 15 / 16) = 2.131 x 1.1902 = 2.536e-7; as
@@ -214,11 +241,13 @@ TEST(EnvelopeDraws, ReplicateIntervalComesFromTheReplicateMeans) {
     v[i].index = i;
     v[i].outcome.residual_imbalance_kgm = 1e-7 * static_cast<double>(i % 16);
   }
-  EXPECT_NEAR(mean_half_width95(v, 16) * 1e7, 2.536, 3e-3);
+  EXPECT_NEAR(mean_half_width95(v, {IntervalKind::Replicates, 16}) * 1e7, 2.536, 3e-3);
   double var = 0;
   for (std::size_t i = 0; i < 32; ++i) var += std::pow(static_cast<double>(i % 16) - 7.5, 2);
   var /= 31;
-  EXPECT_NEAR(mean_half_width95(v, 1) * 1e7, 1.96 * std::sqrt(var / 32), 1e-9);
+  EXPECT_NEAR(mean_half_width95(v, {}) * 1e7, 1.96 * std::sqrt(var / 32), 1e-9);
+  // as 16 strata: every cell holds one value twice, s_h = 0: no spread left
+  EXPECT_EQ(mean_half_width95(v, {IntervalKind::Strata, 16}), 0.0);
 }
 
 // Cheap stand-in for the simulator that depends on every overridden value.

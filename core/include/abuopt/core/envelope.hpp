@@ -7,12 +7,13 @@
 //     imbalance_mass_factor: {uniform: [0.5, 1.5]}  # x abu.imbalance_mass_kg (e fixed)
 //     stiffness_factor: {uniform: [0.95, 1.05]}     # x abu.stiffness_N_per_m (moves omega_n)
 //     restitution: {uniform: [0.5, 0.95]}           # ball-ball, absolute (hard contact)
-//     sampling: sobol                               # or random (EnvelopeSampling)
+//     sampling: stratified                          # or random, sobol (EnvelopeSampling)
 //
 // Each parameter is absent (nominal: the abu section's value), fixed ({fixed: v} or a plain
 // number) or uniform ({uniform: [lo, hi]}). With sampling: random, run i of a study with seed S
-// draws parameter p from u = unit_double(hash_seed(S, tag_p, i)); with sobol, u is coordinate p
-// of the joint point (joint_sobol_coordinate). Either way: replayable from (S, i) alone, independent of the thread
+// draws parameter p from u = unit_double(hash_seed(S, tag_p, i)); stratified: (bit + u) / 2, bit
+// the parameter's bit of run i's cell; sobol: coordinate p of the joint point
+// (joint_sobol_coordinate). Either way: replayable from (S, i) alone, independent of the thread
 // count, of the ranks and of which other parameters are uncertain. Friction and imbalance mass use
 // the streams of montecarlo.friction.range / montecarlo.imbalance.mass_relative_range, so an
 // envelope uniform equals the old key's range draw for draw.
@@ -26,12 +27,17 @@
 namespace abuopt {
 
 enum class DistributionKind { Nominal, Fixed, Uniform };
-// How the varying parameters (and, with montecarlo.design random or sobol, the start angles) are
-// drawn: Sobol (default): one joint scrambled Sobol' point per run (randomised QMC, 16 interleaved
-// independent scramblings: a narrower interval for the same runs, docs/montecarlo.md); Random:
-// each parameter from its own hashed stream (the old keys' draws).
-enum class EnvelopeSampling { Random, Sobol };
-extern const EnumNames<EnvelopeSampling> kEnvelopeSamplingNames;  // random, sobol
+// How the varying parameters are drawn (measured against each other in docs/montecarlo.md):
+//   Stratified (default): the range of each of the P varying parameters is cut in two halves, 2^P
+//     cells; run i lies in cell i mod 2^P (proportional allocation) and is uniform inside it (the
+//     random stream's draw u becomes (bit + u) / 2). Never a wider interval than Random; about
+//     1.2x fewer runs for the same interval over the issue-30 envelope.
+//   Random: each parameter from its own hashed stream (the old keys' draws).
+//   Sobol: one joint scrambled Sobol' point per run for the parameters and, with montecarlo.design
+//     random or sobol, the start angles (randomised QMC, 16 interleaved independent scramblings);
+//     no gain measured here (the response is discontinuous), kept for smooth responses.
+enum class EnvelopeSampling { Random, Stratified, Sobol };
+extern const EnumNames<EnvelopeSampling> kEnvelopeSamplingNames;  // random, stratified, sobol
 std::string to_string(DistributionKind k);
 
 // One uncertain parameter: nominal (absent), fixed at lo (== hi), or uniform in [lo, hi].
@@ -56,7 +62,9 @@ struct Envelope {
   ParameterDistribution imbalance_mass_factor;  // x abu.imbalance_mass_kg
   ParameterDistribution stiffness_factor;       // x abu.stiffness_N_per_m
   ParameterDistribution restitution;            // absolute ball-ball restitution
-  EnvelopeSampling sampling = EnvelopeSampling::Sobol;
+  EnvelopeSampling sampling = EnvelopeSampling::Stratified;
+  // Stratified: the number of cells, 2^(varying parameters); otherwise 1.
+  std::size_t strata() const;
   // Scrambled Sobol': run i is point i / kReplicates of scrambling i mod kReplicates.
   static constexpr std::size_t kReplicates = 16;
   // Joint coordinates: the kParameters parameters first, then the start angles (at most

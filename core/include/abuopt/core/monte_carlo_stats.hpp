@@ -79,12 +79,19 @@ struct MonteCarloStats {
 MonteCarloStats compute_statistics(const std::vector<MonteCarloSample>& samples);
 MonteCarloStats compute_statistics(const MonteCarloResult& result);  // adds wall time, concurrency
 
-// Half-width of the 95 % interval of the mean |I_r| (report_x: I_r,x, in kg m) over the ok runs.
-// replicates <= 1: independent runs, 1.96 s / sqrt(n). replicates R > 1: run i belongs to
-// replicate i mod R, the replicates being independent randomisations of one low-discrepancy
-// design (the envelope's scrambled Sobol' draws, joint_sampling()): t_{R-1} sd(replicate means)
-// / sqrt(R), the randomised-QMC interval. NaN when there are too few ok runs.
-double mean_half_width95(const std::vector<MonteCarloSample>& samples, std::size_t replicates, bool report_x = false);
+// Half-width of the 95 % interval of the mean |I_r| (report_x: I_r,x, in kg m) over the ok runs,
+// for the study's sampling (mean_interval_groups): independent runs: 1.96 s / sqrt(n); strata
+// (the envelope's stratified draws, run i in cell i mod H, weights 1/H): 1.96 sqrt(sum s_h^2 /
+// (H^2 n_h)); replicates (scrambled Sobol', run i in replicate i mod R): t_{R-1} sd(replicate
+// means) / sqrt(R). NaN when there are too few ok runs.
+enum class IntervalKind { Independent, Strata, Replicates };
+struct IntervalLayout {
+  IntervalKind kind = IntervalKind::Independent;
+  std::size_t groups = 1;
+};
+IntervalLayout interval_layout(const MonteCarloStudy& s);
+double mean_half_width95(const std::vector<MonteCarloSample>& samples, const IntervalLayout& layout,
+                         bool report_x = false);
 
 // The summary as one JSON object: runs, ok, failed, status_counts {key: n}, pct_lc, not_settled,
 // wall_time_s, concurrency, magnitude {...}, report_x {...} (count, mean, min, max, median, p10,
