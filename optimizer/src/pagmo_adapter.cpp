@@ -175,9 +175,9 @@ AdapterOutcome run_pagmo(EvaluationDriver& d, const AlgorithmInfo& algorithm, co
     pagmo::population pop(prob, 0u, seed32(options.seed) + 1u);
     for (std::size_t i = 0; i < us.size(); ++i) pop.push_back(us[i], {f[i]});
 
-    // generations: enough for the whole budget; the driver ends the run when it is spent
-    const unsigned generations =
-        static_cast<unsigned>(std::min<long>(options.max_evaluations / static_cast<long>(size) + 2, 100000000L));
+    // generations: as many as evaluations (repeats of known points are answered from memory and do
+    // not count), so the budget or the algorithm's own tolerances end the run
+    const unsigned generations = static_cast<unsigned>(std::min<long>(options.max_evaluations, 100000000L));
     pagmo::algorithm algo = make_algorithm(algorithm.name, options, generations);
     algo.evolve(pop);
     out.reason = TerminationReason::Converged;

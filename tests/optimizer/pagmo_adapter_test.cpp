@@ -12,6 +12,7 @@
 #include "abuopt/optimizer/benchmarking.hpp"
 #include "abuopt/optimizer/benchmarks/benchmark_factory.hpp"
 #include "abuopt/optimizer/minimize.hpp"
+#include "abuopt/optimizer/multi_objective.hpp"
 
 namespace {
 
@@ -170,6 +171,55 @@ TEST(PagmoAdapter, ResumesFromTheArchive) {
     EXPECT_EQ(resumed.runs[i].result.objective, plain.runs[i].result.objective) << i;
   }
   std::filesystem::remove_all(dir);
+}
+
+// Hand-worked: (1, 3), (2, 2), (3, 1) against (4, 4) dominate 3 + 2 + 1 = 6; a dominated point and
+// one beyond the reference add nothing.
+TEST(TwoObjectives, HypervolumeOfAHandWorkedFront) {
+  EXPECT_DOUBLE_EQ(opt::hypervolume_2d({{1, 3}, {2, 2}, {3, 1}}, {4, 4}), 6.0);
+  EXPECT_DOUBLE_EQ(opt::hypervolume_2d({{3, 1}, {3, 3}, {1, 3}, {2, 2}, {5, 0}}, {4, 4}), 6.0);
+  EXPECT_EQ(opt::non_dominated_2d({{3, 3}, {1, 3}, {2, 2}}).size(), 2u);
+}
+
+// ZDT1 in two variables: f1 = x0, f2 = g (1 - sqrt(f1 / g)), g = 1 + 9 x1; the front is x1 = 0,
+// f2 = 1 - sqrt(f1), whose hypervolume against (1, 1) is the integral of sqrt(f1) = 2/3. With the
+// constraint x0 >= 0.2 the front starts at f1 = 0.2: 2/3 (1 - 0.2^1.5) = 0.60704.
+opt::FunctionProblem zdt1(bool constrained) {
+  auto f = [constrained](const std::vector<double>& x) {
+    opt::Evaluation e;
+    const double g = 1 + 9 * x[1];
+    e.objective = x[0];
+    e.metrics["f2"] = g * (1 - std::sqrt(x[0] / g));
+    if (constrained) e.inequality = {0.2 - x[0]};
+    return e;
+  };
+  return opt::FunctionProblem(constrained ? "zdt1_c" : "zdt1", {{"x0", 0, 1, 1}, {"x1", 0, 1, 1}}, f,
+                              constrained ? std::vector<std::string>{"x0_min"} : std::vector<std::string>{});
+}
+
+TEST(TwoObjectives, Nsga2ApproachesTheZdt1Front) {
+  for (const bool constrained : {false, true}) {
+    opt::FunctionProblem p = zdt1(constrained);
+    opt::OptimizerOptions o = options("pagmo_cmaes", 800, 5);  // the algorithm key is not used
+    o.population = 20;
+    const opt::TwoObjectiveResult r = opt::minimize_two_objectives(p, "f2", o);
+    EXPECT_EQ(r.run.evaluations, 800);
+    ASSERT_GE(r.front.size(), 10u) << constrained;
+    const double exact = constrained ? 2.0 / 3.0 * (1 - std::pow(0.2, 1.5)) : 2.0 / 3.0;
+    const double hv = opt::hypervolume_2d(r.front_objectives(), {1, 1});
+    EXPECT_LE(hv, exact + 1e-12) << constrained;  // nothing beats the true front
+    EXPECT_GE(hv, 0.97 * exact) << constrained;
+    for (std::size_t i : r.front) {
+      EXPECT_TRUE(r.run.history[i].feasible);
+      if (constrained) EXPECT_GE(r.run.history[i].x[0], 0.2 - 1e-6);
+    }
+  }
+  opt::FunctionProblem p = zdt1(false);
+  opt::OptimizerOptions o = options("cobyla", 100);
+  o.population = 10;  // not a multiple of 4
+  EXPECT_THROW((void)opt::minimize_two_objectives(p, "f2", o), ConfigError);
+  o.population = 0;
+  EXPECT_THROW((void)opt::minimize_two_objectives(p, "", o), ConfigError);
 }
 
 }  // namespace
