@@ -84,14 +84,15 @@ def report(directory):
             where = "out of sample" if validated else "in sample"
             value = num(best_row["validated_objective"] if validated else best_row["best_true_objective"])
             out.append(f"Best found {where}: **{fmt(value, 6)}** by {best_row['solver']} (start {best_row['start']}), "
-                       f"design x = ({best_row.get('x', '').replace(' ', ', ')}); in-sample f* (the reference of "
+                       f"design x = ({', '.join(fmt(num(v), 5) for v in best_row.get('x', '').split())}); in-sample f* (the reference of "
                        f"the 1 % / 2 % columns) = {fmt(f_star, 6)}.\n")
         else:
             out.append(f"No feasible design; f* = {fmt(f_star, 6)}.\n")
+        best_out = num(best_row["validated_objective"]) if (validated and best_row is not None) else math.nan
         head = ("| method | feasible in / out of sample | median best f (in) | spread (in) | median f (out) | "
-                "spread (out) | evals to 1 % | evals to 2 % |")
+                "spread (out) | median gap (out) | evals to 1 % | evals to 2 % |")
         out.append(head)
-        out.append("|" + "---|" * 8)
+        out.append("|" + "---|" * 9)
         for s in solvers:
             rs = [r for r in rows if r["solver"] == s]
             n = len(rs)
@@ -106,9 +107,13 @@ def report(directory):
                 # median over every run, a run that never got there counting as infinitely many
                 med = statistics.median([math.inf if v is None else v for v in t]) if t else math.inf
                 cells.append(f"{fmt(float(med), 4) if math.isfinite(med) else '-'} ({len(got)}/{n})")
+            gap = "-"
+            outs = [num(r["validated_objective"]) for r in rs if r.get("validated_feasible") == "1"]
+            if outs and math.isfinite(best_out):
+                gap = f"{100 * (statistics.median(outs) - best_out) / max(abs(best_out), 1e-300):.1f} %"
             out.append(f"| {s} | {feas_in}/{n} / {feas_out if validated else '-'}/{n if validated else '-'} | "
                        f"{med_in} | {spr_in} | {med_out if validated else '-'} | {spr_out if validated else '-'} | "
-                       f"{cells[0]} | {cells[1]} |")
+                       f"{gap} | {cells[0]} | {cells[1]} |")
         out.append("")
     return "\n".join(out)
 
@@ -124,7 +129,7 @@ def main():
              "`abuopt compare` (configs/compare/adopt_benchmarks.yaml, adopt_suite.yaml); do not edit by hand. "
              "Per problem: the best-known value and its design, then per method over its runs (starts x seeds): "
              "runs feasible in sample / out of sample, the median and range of the best in-sample objective and "
-             "of the validated (out-of-sample) objective, and the evaluations until the best feasible in-sample "
+             "of the validated (out-of-sample) objective over the runs feasible out of sample, that median's gap to the best validated value, and the evaluations until the best feasible in-sample "
              "value is within 1 % / 2 % of f* (median over all runs, a run that never got there counting as infinite; in brackets how many got there).\n"]
     if a.intro:
         with open(a.intro) as f:
