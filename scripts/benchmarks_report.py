@@ -86,6 +86,11 @@ def report(directory):
             out.append(f"Best found {where}: **{fmt(value, 6)}** by {best_row['solver']} (start {best_row['start']}), "
                        f"design x = ({', '.join(fmt(num(v), 5) for v in best_row.get('x', '').split())}); in-sample f* (the reference of "
                        f"the 1 % / 2 % columns) = {fmt(f_star, 6)}.\n")
+        elif validated:
+            least = min(validated, key=lambda r: num(r["validated_max_violation"]))
+            out.append(f"No design feasible out of sample; the least out-of-sample violation is "
+                       f"{fmt(num(least['validated_max_violation']), 4)} (f = {fmt(num(least['validated_objective']), 6)}) "
+                       f"by {least['solver']} (start {least['start']}); in-sample f* = {fmt(f_star, 6)}.\n")
         else:
             out.append(f"No feasible design; f* = {fmt(f_star, 6)}.\n")
         best_out = num(best_row["validated_objective"]) if (validated and best_row is not None) else math.nan
