@@ -69,10 +69,12 @@ int run_cli(int argc, char** argv) {
       "design, an evaluation error ended it, out of memory); 4 an output file could not be written (disk\n"
       "full, no permission: nothing half-written is left under its name); 130 interrupted (Ctrl-C).\n"
       "docs/security.md says what abuopt trusts, where it writes and how it runs gnuplot."};
-  app.footer("\n" + abuopt::terms_text(""));
   app.require_subcommand(1);
   app.set_version_flag("--version", "abuopt " + abuopt::abuopt_version() + " (" + abuopt::abuopt_git_commit() + ")");
   abuopt::app::register_all(app);
+  // After the subcommands: CLI11 copies a footer into every subcommand made later, and the terms
+  // belong once in `abuopt --help` (the commands that print them point here).
+  app.footer("\n" + abuopt::terms_text(""));
 
   try {
     app.parse(argc, argv);

@@ -19,11 +19,12 @@ packages=(
   libgtest-dev           # tests
   libbenchmark-dev       # bench/
   gnuplot-nox            # plots (optional at run time: studies skip plots without it)
+  doxygen                # the optional API reference target `doc` (cmake/AbuoptData.cmake)
   clang libclang-rt-14-dev  # libFuzzer targets (fuzz/, scripts/fuzz.sh) with ASan/UBSan runtimes
   python3                # scripts/startup_study.py, scripts/final_states_in_set.py (standard library only)
   python3-dev pybind11-dev python3-numpy  # the Python module abuopt (python/; skipped without them)
   python3-scipy python3-matplotlib        # examples/python (each says so and exits 0 without its package)
-  python3-yaml           # scripts/stop_distribution.py, scripts/pi_feedforward.py read configs (and their tests)
+  python3-yaml           # scripts/stop_distribution.py reads configs (and its test)
 )
 
 missing=()

@@ -2,7 +2,7 @@
 """Speed against time of the startup profiles of ready-to-run configs, the 2003 profile beside them (issue 10,
 docs/studies/startup-profile.md 8.13: the shipped designs of configs/studies/best/, which the runner did not make).
 
-    scripts/plot_profiles.py configs/studies/best/best_19s.yaml configs/studies/best/contact_best_mu03_deepshake_6balls.yaml \
+    scripts/plot_profiles.py configs/studies/best/best_19s.yaml configs/designs/mu03_6balls_17s.yaml \
         --out results/profiles [--title TEXT] [--zoom 18:32]
 
 Reads each config's `profile` section (start_frequency_hz and the segments' end_frequency_hz / duration_s; the

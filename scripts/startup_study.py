@@ -112,11 +112,11 @@ SHAKE_RATE_MARGIN = 1.001  # 0.1 % inside the limit: x0 printed to 6 digits cann
 DEEP_BOTTOMS_HZ = (20.0, 21.5, 22.5, 23.5, 25.0)
 # Stage 6's check of the designs shipped in configs/studies/best/ that were made outside the runner (by hand and by
 # scripts/g6_multistart.py; docs/studies/startup-profile.md 8.13): validated as shipped, with contact only (they set
-# it), so their figures come out of the one command: (name, file in configs/studies/best/, friction).
-SHIPPED = [("contact_best_19s_deep_6balls", "contact_best_19s_deep_6balls.yaml", 0.02),
-           ("contact_best_mu03_deepshake_6balls", "contact_best_mu03_deepshake_6balls.yaml", 0.03),
-           ("contact_best_mu03_twodeep_6balls", "contact_best_mu03_twodeep_6balls.yaml", 0.03),
-           ("contact_best_mu03_g6", "contact_best_mu03_g6.yaml", 0.03)]
+# it), so their figures come out of the one command: (name, file under configs/, friction).
+SHIPPED = [("contact_best_19s_deep_6balls", "studies/best/contact_best_19s_deep_6balls.yaml", 0.02),
+           ("contact_best_mu03_deepshake_6balls", "designs/mu03_6balls_17s.yaml", 0.03),
+           ("contact_best_mu03_twodeep_6balls", "studies/best/contact_best_mu03_twodeep_6balls.yaml", 0.03),
+           ("contact_best_mu03_g6", "studies/best/contact_best_mu03_g6.yaml", 0.03)]
 # The ball count of the last polish of 4c (equal total ball mass, equal_mass_balls); --shake-balls. Set from the
 # robust helper's re-optimisation of the two-shake design with N = 3..6 balls (6 balls: 12.83 against 14.12 with 2).
 SHAKE_BALLS = 6
@@ -1534,7 +1534,7 @@ def shipped_validation(st, table, made=()):
         return []
     val_dir, rows = os.path.join(st.out, "validation"), []
     items = [(n, t, mu, "runner") for n, t, mu in made]
-    items += [(n, read(os.path.join(ROOT, "configs", "studies", "best", fn)), mu, "shipped") for n, fn, mu in SHIPPED]
+    items += [(n, read(os.path.join(ROOT, "configs", fn)), mu, "shipped") for n, fn, mu in SHIPPED]
     for name, text, mu, source in items:
         bl = balls_of(text)
         # one reference per ball set and friction, shared by the designs with those balls (its text must not name one)

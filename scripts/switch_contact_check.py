@@ -24,12 +24,12 @@ BEST = "configs/studies/best"
 # (name, config, extra montecarlo arguments)
 DESIGNS = [
     ("report_2003", "configs/report_final_profile.yaml", []),
-    ("contact_best_19s", BEST + "/contact_best_19s.yaml", []),
+    ("contact_best_19s", "configs/designs/two_balls_19s.yaml", []),
     ("contact_best_8s", BEST + "/contact_best_8s.yaml", []),
-    ("contact_f2_min_T", BEST + "/contact_f2_min_T.yaml", []),
+    ("contact_f2_min_T", "configs/designs/fast_2balls_8s.yaml", []),
     ("contact_best_mu03 (mu 0.03)", BEST + "/contact_best_mu03.yaml", ["--mu", "0.03"]),
     ("contact_best_robust", BEST + "/contact_best_robust.yaml", []),
-    ("contact_f2_min_T_pi (PI motor)", BEST + "/contact_f2_min_T_pi.yaml", []),
+    ("contact_f2_min_T_pi (PI motor)", "configs/designs/fast_2balls_8s_pi.yaml", []),
     ("contact_best_mu03_k4 (mu 0.03)", BEST + "/contact_best_mu03_k4.yaml", ["--mu", "0.03"]),
 ]
 

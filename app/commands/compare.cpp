@@ -129,13 +129,10 @@ opt::ProblemSpec read_problem(YamlReader& r) {
   return spec;
 }
 
-std::string timestamp() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  localtime_r(&t, &tm);
-  std::ostringstream os;
-  os << std::put_time(&tm, "%Y%m%d-%H%M%S");
-  return os.str();
+// The default output folder: results/compare-<config stem>, the same for every run of the same
+// config, so that a plain rerun after an interruption resumes from OUT/archive/.
+std::string default_out(const std::string& config) {
+  return "results/compare-" + std::filesystem::path(config).stem().string();
 }
 
 nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
@@ -159,7 +156,7 @@ int run_compare(const CompareArgs& a) {
 
   std::size_t total = 0;
   for (const auto& p : setup.problems) total += static_cast<std::size_t>(p.starts) * setup.solvers.size();
-  const std::string out = a.out.empty() ? "results/compare-" + timestamp() : a.out;
+  const std::string out = a.out.empty() ? default_out(a.config) : a.out;
   const OutputDirLock lock(out);  // one run per output directory (created here)
   // every run keeps its evaluations in OUT/archive/: a rerun of a killed comparison resumes
   setup.archive_directory = (std::filesystem::path(out) / "archive").string();
@@ -253,12 +250,12 @@ void register_compare(CLI::App& app) {
       "Compare optimisers (NLopt algorithms, IPOPT, SAO) on benchmark problems from several starts, each\n"
       "with an evaluation budget: a table (solved runs, evaluations to reach tau, best value, feasibility,\n"
       "time), convergence curves, data profiles and performance profiles (CSV, and PNG + PDF with gnuplot).\n"
-      "Every evaluation is archived in OUT/archive/: rerunning the same command with the same --out after\n"
-      "an interruption resumes (stored evaluations are answered from the archive, bit for bit).\n"
+      "Every evaluation is archived in OUT/archive/: rerunning the same command (same config, same --out or\n"
+      "none) after an interruption resumes (stored evaluations are answered from the archive, bit for bit).\n"
       "Exit status: 0 ok, 2 bad input.");
   sub->add_option("config", args->config, "YAML config (tau, problems, solvers; see configs/compare/)")->required();
   sub->add_option("--out", args->out,
-                  "output directory (default results/compare-<timestamp>/); give it to resume a comparison");
+                  "output directory (default results/compare-<config stem>/: a rerun of the same config resumes there)");
   sub->add_flag("--json", args->json, "print one JSON object (runs and files) instead of the table");
   sub->add_flag("--progress", args->progress, "show runs done, rate and ETA on stderr also when it is not a terminal");
   sub->callback([args] { set_exit_code(run_compare(*args)); });

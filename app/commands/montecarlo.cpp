@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "abuopt/common/config_sections.hpp"
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/gnuplot.hpp"
 #include "abuopt/common/output_file.hpp"
@@ -134,14 +135,17 @@ PlotStatus plot_residual_histogram(const std::string& dir, const MonteCarloResul
   const double threshold = imbalance_kgm * 1e7;
   std::ostringstream b;
   b << "set datafile separator ','\nset datafile columnheaders\n"
-    << "set title " << plot_style::literal("Residual imbalance of " + std::to_string(ok) + " runs (" + what + ")") << "\n"
+    // `what`: "<config>, profile ...|<design>": the title names the profile, a label the sample
+    << "set title " << plot_style::literal("Residual imbalance of " + std::to_string(ok) + " runs: " + what.substr(0, what.find('|')))
+    << "\nset label 2 " << plot_style::literal(what.find('|') == std::string::npos ? std::string() : what.substr(what.find('|') + 1))
+    << " at graph 0.98, graph 0.95 right front boxed\nset style textbox opaque noborder fillcolor rgb '#ffffff'\n"
     << "set xlabel 'residual imbalance [10^{-7} kg m]'\nset ylabel 'runs per bin'\n"
     << "ir(c) = (strcol('status') eq 'ok') ? column(c) * 1e7 : NaN\n"
     << "stats 'runs.csv' using (ir('ir_magnitude_kgm')) nooutput\n"
     << "w = STATS_max > 0 ? STATS_max / 40 : 1\n"
     << "bin(x) = w * (floor(x / w) + 0.5)\n"
     << "set boxwidth w\nset style fill transparent solid 0.45 border\nset xrange [0:*]\nset yrange [0:*]\n"
-    << "set grid\nset key top left\n"
+    << "set grid\nset key below horizontal\n"  // below the axes: never over the (tallest, leftmost) bars
     << "set arrow 1 from " << format_number(threshold) << ", graph 0 to " << format_number(threshold)
     << ", graph 1 nohead dt 2 lw 2 lc rgb '" << plot_style::kRed << "'\n"
     << "plot 'runs.csv' using (bin(ir('ir_magnitude_kgm'))):(1.0) smooth frequency with boxes lt 1 title '|I_r|', \\\n"
@@ -165,7 +169,7 @@ int run_montecarlo(const MonteCarloArgs& a) {
   YamlReader root = YamlReader::load_file(a.config);
   SimulationSetup setup = read_simulation_setup(root);
   MonteCarloConfig cfg = read_monte_carlo_config_unchecked(root, std::move(setup));
-  root.finish();
+  finish_config(root);
   apply_overrides(a, cfg);
   std::optional<OutputDirLock> lock;  // one run per output directory
   if (!a.out.empty()) lock.emplace(a.out);
@@ -194,8 +198,12 @@ int run_montecarlo(const MonteCarloArgs& a) {
                            {"config_hash", prov.config_hash}};
   PlotStatus plot;
   if (!a.out.empty()) {
+    // The title names the config and its profile (segments: end frequency in duration), then the sample.
     std::ostringstream what;
-    what << to_string(study_design(s).kind) << " design, seed " << s.seed << ", μ = " << friction_text(s);
+    what << "profile " << format_number(s.setup.profile.start_frequency_hz());
+    for (const auto& seg : s.setup.profile.segments())
+      what << " → " << format_number(seg.end_frequency_hz) << " Hz in " << format_number(seg.duration_s) << " s";
+    what << "|" << std::filesystem::path(a.config).stem().string() << ": " << to_string(study_design(s).kind) << " design, seed " << s.seed << ", μ = " << friction_text(s);
     plot = write_outputs(a.out, result, summary, s.setup.abu.imbalance_kgm(), what.str());
   }
 
@@ -212,7 +220,7 @@ int run_montecarlo(const MonteCarloArgs& a) {
               << " s, imbalance without balls I = " << std::setprecision(4) << s.setup.abu.imbalance_kgm() * 1e7
               << "e-7 kg m\n"
               << std::setprecision(6) << format_summary(stats);
-    std::cout << terms_text("");
+    std::cout << terms_pointer() << "\n";
     if (!a.out.empty())
       std::cout << "wrote " << a.out << "/runs.csv and " << a.out << "/summary.json\n"
                 << (plot.ran() ? "plot: " + plot.png_path + " and " + plot.pdf_path : "plot " + plot.message) << "\n";
@@ -236,7 +244,7 @@ void register_montecarlo(CLI::App& app) {
       "95 % Wilson interval, %LC, settling time, peak amplitude, failed runs. Uses all cores; results do\n"
       "not depend on the thread count. Options override the config's `montecarlo` section.\n"
       "Exit status: 0 ok, 2 bad input, 3 every run failed.");
-  sub->footer("\n" + terms_text(""));
+  sub->footer("\n" + terms_pointer());
   sub->add_option("config", args->config, "YAML config (sections abu, profile, motor, simulation, montecarlo)")
       ->required();
   sub->add_option("--runs", args->runs, "number of runs (grid design: must equal grid^balls)");

@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "abuopt/common/config_sections.hpp"
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/gnuplot.hpp"
 #include "abuopt/common/plot_style.hpp"
@@ -32,6 +33,7 @@
 #include "abuopt/parallel/parallel.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
 #include "abuopt/studies/out_of_sample.hpp"
+#include "abuopt/studies/sweep.hpp"
 #include "abuopt/studies/terms.hpp"
 #include "commands/commands.hpp"
 
@@ -63,9 +65,7 @@ LoadedConfig load_config(const OptimizeArgs& a) {
   YamlReader optimizer = root.child("optimizer");
   YamlReader sao = root.child("sao");
   c.options = opt::read_optimizer_options(optimizer, &sao);
-  root.mark_read("sweep");   // the same file may configure `abuopt sweep` and `abuopt pareto`
-  root.mark_read("pareto");
-  root.finish();
+  finish_config(root);  // the same file may configure `abuopt sweep` and `abuopt pareto`
   if (a.max_evaluations) {
     if (*a.max_evaluations < 1)
       throw ConfigError("--max-evaluations", std::to_string(*a.max_evaluations), "must be >= 1");
@@ -157,14 +157,20 @@ void write_history_csv(const fs::path& path, const opt::OptimizationResult& r) {
 
 // convergence.csv (+ .png and .pdf): objective of every evaluation, of the feasible ones, best
 // feasible so far. Returns the plot's status (its PNG and PDF paths when made).
-PlotStatus write_convergence(const fs::path& dir, const opt::OptimizationResult& r) {
+// convergence.png: the objective of every evaluation (its quantity and unit on the y axis), the
+// feasible ones filled, the best feasible so far as steps, and the largest constraint violation
+// (relative, log scale, right axis) of the infeasible ones, so a reader sees why a low point is not
+// the best.
+PlotStatus write_convergence(const fs::path& dir, const opt::OptimizationResult& r, const std::string& ylabel) {
   const fs::path csv = dir / "convergence.csv", png = dir / "convergence.png";
+  bool any_violation = false;
   {
     AtomicFile f(csv);
     f << "evaluation,objective,feasible_objective,best_feasible_objective,max_violation\n";
     double best = std::numeric_limits<double>::infinity();
     for (const auto& h : r.history) {
       if (h.feasible && h.objective < best) best = h.objective;
+      any_violation = any_violation || (std::isfinite(h.max_violation) && h.max_violation > 0 && !h.feasible);
       f << h.index + 1 << "," << (h.ok && std::isfinite(h.objective) ? format_number(h.objective) : "") << ","
         << (h.feasible ? format_number(h.objective) : "") << "," << (std::isfinite(best) ? format_number(best) : "")
         << "," << (std::isfinite(h.max_violation) ? format_number(h.max_violation) : "") << "\n";
@@ -176,15 +182,23 @@ PlotStatus write_convergence(const fs::path& dir, const opt::OptimizationResult&
     skipped.message = "skipped: interrupted under mpirun (a rerun with the same --out plots it)";
     return skipped;
   }
-  XYLinesPlot p;
-  p.csv_path = csv.string();
-  p.png_path = png.string();
-  p.labels = {"Convergence of " + plot_style::escape(r.algorithm) + " on " + plot_style::escape(r.problem_name),
-              "evaluation", "objective"};
-  p.series = {{1, 2, "every evaluation", "points pt 6 ps 1.6"},
-              {1, 3, "feasible", "points pt 7 ps 0.8"},
-              {1, 4, "best feasible so far", "steps"}};
-  return Gnuplot().xy_lines(p);
+  std::ostringstream b;
+  const std::string q = Gnuplot::quote("convergence.csv");
+  b << "set datafile separator ','\n"
+    << "set title " << plot_style::literal("Convergence of " + r.algorithm + " on " + r.problem_name) << "\n"
+    << "set xlabel 'evaluation'\nset ylabel " << plot_style::literal("objective: " + ylabel) << "\n"
+    << "set key at screen 0.5, 0.02 center bottom horizontal maxrows 2 box opaque\nset bmargin 7\nset grid\n";
+  if (any_violation)
+    b << "set y2label 'largest constraint violation (relative; infeasible points)'\nset logscale y2\n"
+         "set y2tics nomirror\nset ytics nomirror\n";
+  b << "plot " << q << " skip 1 using 1:2 with points lt 1 pt 6 ps 1.4 title 'every evaluation', \\\n"
+    << "     " << q << " skip 1 using 1:3 with points lt 1 pt 7 ps 0.8 title 'feasible (filled)', \\\n"
+    << "     " << q << " skip 1 using 1:4 with steps lt 3 lw 2 title 'best feasible so far'";
+  if (any_violation)
+    b << ", \\\n     " << q << " skip 1 using 1:(($5 > 0 && strlen(strcol(3)) == 0) ? $5 : NaN) axes x1y2 "
+      << "with points lt 4 pt 2 ps 1.0 title 'constraint violation (right axis, x)'";
+  b << "\n";
+  return Gnuplot().run(b.str(), (dir / "convergence.gp").string(), png.string(), 900, 650);
 }
 
 // One line for the log: where the plot is, or why not.
@@ -349,7 +363,7 @@ int run_optimize(const OptimizeArgs& a) {
 
   // Files first (a Ctrl-C during the validation below still leaves them), result.json again after it.
   write_history_csv(out / "history.csv", r);
-  const PlotStatus plot = write_convergence(out, r);
+  const PlotStatus plot = write_convergence(out, r, objective_label(st));
   if (have_best) write_best_profile(out / "best_profile.yaml", problem, r, a.config);
   j["files"] = {{"history", (out / "history.csv").string()},
                 {"convergence_csv", (out / "convergence.csv").string()},
@@ -373,7 +387,8 @@ int run_optimize(const OptimizeArgs& a) {
     const OutOfSampleComparison cmp = compare_out_of_sample(problem, r, penalised ? &*penalised : nullptr);
     const StartupProfile& report = cmp.report;
     const std::vector<ComparisonRow>& rows = cmp.rows;
-    log << comparison_table(rows) << terms_text("  ");
+    const OutOfSampleVerdict verdict = out_of_sample_verdict(rows);
+    log << comparison_table(rows) << verdict.text << "  " << terms_pointer() << "\n";
     log << "  report profile: " << profile_text(report) << "\n";
     j["validation"] = {{"runs", v.runs},
                        {"design", to_string(v.design)},
@@ -382,7 +397,8 @@ int run_optimize(const OptimizeArgs& a) {
                                  {"out_of_sample", evaluation_json(rows[1].e, g_names)}}},
                        {"report_profile", {{"profile", profile_json(report)},
                                            {"in_sample", evaluation_json(rows[2].e, g_names)},
-                                           {"out_of_sample", evaluation_json(rows[3].e, g_names)}}}};
+                                           {"out_of_sample", evaluation_json(rows[3].e, g_names)}}},
+                       {"worse_than_report_profile", verdict.worse}};
     write_json();
   } else if (interrupted) {
     log << "interrupted: the best design so far is written; rerun the same command to resume from the archive\n";
@@ -420,7 +436,7 @@ void register_optimize(CLI::App& app) {
       "and the report's final profile are evaluated on a fresh, larger set of initial conditions.\n"
       "Exit status: 0 ok, 2 bad input, 3 no feasible design found or the run ended on an evaluation\n"
       "error (the reason is printed), 4 an output file could not be written, 130 interrupted (Ctrl-C).");
-  sub->footer("\n" + terms_text(""));
+  sub->footer("\n" + terms_pointer());
   sub->add_option("config", args->config,
                   "YAML config (abu, profile, motor, simulation, montecarlo, design, objective, constraints,\n"
                   "validation, optimizer, sao); see configs/optimize/ and docs/optimize.md")

@@ -1,7 +1,9 @@
 // abuopt pareto CONFIG: the Pareto front of startup time against the objective (mean |I_r|) by the
 // epsilon-constraint method (studies/pareto.hpp): one optimisation per bound on the startup time,
 // each archived, then each front point and the report's profile out of sample. docs/sweep.md.
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -11,8 +13,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "abuopt/common/config_sections.hpp"
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/output_file.hpp"
+#include "abuopt/common/progress.hpp"
 #include "abuopt/common/provenance.hpp"
 #include "abuopt/common/text.hpp"
 #include "abuopt/optimizer/minimize.hpp"
@@ -32,6 +36,7 @@ struct ParetoArgs {
   std::string config;
   std::string out;
   bool json = false;
+  bool progress = false;
   std::optional<long> threads;
 };
 
@@ -49,8 +54,7 @@ int run_pareto_command(const ParetoArgs& a) {
   YamlReader sao = root.child("sao");
   opt::OptimizerOptions options = opt::read_optimizer_options(optimizer, &sao);
   const ParetoSettings ps = read_pareto_settings(root.child("pareto"));
-  root.mark_read("sweep");
-  root.finish();
+  finish_config(root);  // the file may also configure `abuopt optimize` and `abuopt sweep`
   options.validate();
   if (a.threads) {
     if (*a.threads < 0) throw ConfigError("--threads", std::to_string(*a.threads), "must be >= 0 (0 = all cores)");
@@ -69,19 +73,34 @@ int run_pareto_command(const ParetoArgs& a) {
       << "  archive " << (out / "archive.sqlite").string() << " (a rerun resumes)\n"
       << std::flush;
 
-  std::size_t current = static_cast<std::size_t>(-1);
+  // Progress: evaluations against the budget of every bound and start (an optimiser that stops
+  // early moves the bar on to the next bound), with rate and ETA on stderr (docs/figures.md).
+  const std::size_t per_bound =
+      static_cast<std::size_t>(std::max(1L, options.max_evaluations)) * (ps.warm_start ? 2u : 1u);
+  ProgressReporter bar("pareto", "evaluations", per_bound * ps.max_startup_time_s.size(),
+                       a.progress ? ProgressMode::Always : ProgressMode::Auto);
+  std::FILE* log_file = a.json ? stderr : stdout;
+  std::size_t current = static_cast<std::size_t>(-1), done = 0;
   const ParetoProgress progress = [&](std::size_t k, std::size_t n, const opt::Progress& p) {
     if (k != current) {
       current = k;
-      log << "bound " << k + 1 << "/" << n << ": T <= " << format_number(ps.max_startup_time_s[k]) << " s\n";
+      done = std::max(done, k * per_bound);
+      bar.message("bound " + std::to_string(k + 1) + "/" + std::to_string(n) + ": T <= " +
+                      format_number(ps.max_startup_time_s[k]) + " s",
+                  log_file);
     }
-    if (!p.last.for_gradient && (p.evaluations % 10 == 0 || p.evaluations == 1))
-      log << "  eval " << std::setw(4) << p.evaluations << "  best=" << (p.have_feasible ? format_number(p.best_objective) : "none")
-          << (p.last.from_archive ? "  [archive]" : "") << "\n" << std::flush;
+    bar.update(++done);
+    if (!p.last.for_gradient && (p.evaluations % 10 == 0 || p.evaluations == 1)) {
+      std::ostringstream line;
+      line << "  eval " << std::setw(4) << p.evaluations << "  best="
+           << (p.have_feasible ? format_number(p.best_objective) : "none") << (p.last.from_archive ? "  [archive]" : "");
+      bar.message(line.str(), log_file);
+    }
     return true;
   };
   const ParetoResult r = run_pareto(settings, options, ps, (out / "archive.sqlite").string(), a.config,
                                     prov.config_hash, progress, true);
+  bar.finish();
   const std::string plot = write_pareto_outputs(out, shape, r);
 
   log << "\n  T bound   T [s]  objective (in)   out-of-sample        %MI in/out   evals  kept run\n";
@@ -175,6 +194,8 @@ void register_pareto(CLI::App& app) {
       ->required();
   sub->add_option("--out", args->out, "output directory (default results/<config stem>)");
   sub->add_flag("--json", args->json, "print summary.json to stdout (progress goes to stderr)");
+  sub->add_flag("--progress", args->progress,
+                "show evaluations done, rate and ETA on stderr also when it is not a terminal (on a terminal: always)");
   sub->add_option("--threads", args->threads, "Monte Carlo worker threads (0 = all cores; overrides montecarlo.threads)");
   sub->callback([args] { set_exit_code(run_pareto_command(*args)); });
 }

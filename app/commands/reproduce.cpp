@@ -121,7 +121,7 @@ int run_reproduce(const ReproduceArgs& a) {
                "direction holds on the point estimates only):\n";
   if (verdicts.empty()) std::cout << "  (none: the tables that carry them were not run)\n";
   for (const Verdict& v : verdicts) std::cout << "  " << v.one_line() << "\n";
-  std::cout << terms_text("");
+  std::cout << terms_pointer() << "\n";
   if (!r.plots.empty()) {
     std::cout << "Plots (PNG; a PDF and the gnuplot script beside each):\n";
     for (const PlotNote& p : r.plots) std::cout << "  " << p.name << ": " << (p.made ? p.png : p.message) << "\n";
@@ -152,7 +152,7 @@ void register_reproduce(CLI::App& app) {
       "verdict per published conclusion. Writes per-case run CSVs (as each case ends), tables.csv,\n"
       "report.md and plots into --out. Exit status: 0 ok, 2 bad input, 3 every run of some case failed,\n"
       "4 an output file could not be written.");
-  sub->footer("\n" + terms_text(""));
+  sub->footer("\n" + terms_pointer());
   sub->add_option("--runs", args->runs,
                   "runs per case for every case: an n x n grid with n = round(sqrt(N)) (default: the report's counts)");
   sub->add_option("--only", args->only, "comma-separated table ids: 4.1, 4.2, 4.3, 4.4, final, mu (default: all)")

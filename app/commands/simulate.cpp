@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "abuopt/common/config_sections.hpp"
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/text.hpp"
@@ -52,7 +53,7 @@ int run_simulate(const SimulateArgs& a) {
   SimulationSetup setup = read_simulation_setup(root);
   // A montecarlo section (a config that `abuopt montecarlo` also runs) is checked and not used.
   if (root.has("montecarlo")) (void)read_monte_carlo_config(root, setup);
-  root.finish();
+  finish_config(root);
   if (a.mu) {
     if (!(std::isfinite(*a.mu) && *a.mu >= 0 && *a.mu <= 0.999))
       throw ConfigError("--mu", format_number(*a.mu), "must be a friction coefficient in [0, 0.999]");
@@ -123,9 +124,10 @@ int run_simulate(const SimulateArgs& a) {
     for (double b : beta0) std::cout << b << " ";
     std::cout << "\nfinal angles [rad]:   ";
     for (double b : o.beta_final) std::cout << b << " ";
-    std::cout << "\nresidual imbalance:   |I_r| = " << o.residual_imbalance_kgm << " kg m, I_r,x = "
-              << o.residual_imbalance_x_kgm << " kg m (without balls: " << I0 << " kg m, ratio "
-              << o.residual_imbalance_kgm / I0 << ")\n";
+    // 1e-7 kg m as every other printout (the terms in `abuopt --help`); --json gives kg m (SI)
+    std::cout << "\nresidual imbalance:   |I_r| = " << o.residual_imbalance_kgm * 1e7 << "e-7 kg m, I_r,x = "
+              << o.residual_imbalance_x_kgm * 1e7 << "e-7 kg m (without balls: I = " << I0 * 1e7
+              << "e-7 kg m, ratio |I_r| / I = " << o.residual_imbalance_kgm / I0 << ")\n";
     std::cout << "settled:              " << (o.settled ? "yes, at t = " + std::to_string(o.settling_time_s) + " s" : "no (balls still moving at the end: limit cycle)") << "\n";
     std::cout << "peak amplitude:       " << o.max_amplitude_mm << " mm\n";
     std::cout << "end time:             " << o.end_time_s << " s\n";

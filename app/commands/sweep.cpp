@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "abuopt/common/config_sections.hpp"
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/provenance.hpp"
@@ -72,7 +73,6 @@ int run_sweep_command(const SweepArgs& a) {
   YamlReader sao = root.child("sao");
   const opt::OptimizerOptions options = opt::read_optimizer_options(optimizer, &sao);  // constraint_tolerance
   YamlReader sweep_section = root.child("sweep");
-  root.mark_read("pareto");  // the same file may configure `abuopt pareto`
   if (a.threads) {
     if (*a.threads < 0) throw ConfigError("--threads", std::to_string(*a.threads), "must be >= 0 (0 = all cores)");
     settings.threads = static_cast<std::size_t>(*a.threads);
@@ -80,7 +80,7 @@ int run_sweep_command(const SweepArgs& a) {
   problems::StartupProfileProblem problem(settings);
   const auto vars = problem.variables();
   const SweepSettings ss = read_sweep_settings(sweep_section, vars);
-  root.finish();
+  finish_config(root);  // the file may also configure `abuopt optimize` and `abuopt pareto`
   const SweepPlan plan = plan_sweep(ss, vars, problem.initial_point());
 
   const fs::path out = a.out.empty() ? fs::path("results") / fs::path(a.config).stem() : fs::path(a.out);

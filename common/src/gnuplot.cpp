@@ -229,6 +229,11 @@ int Gnuplot::run_script(const std::string& script_path, const std::string& worki
     }
     ::close(log);
   }
+  // gnuplot says nothing when all is well: an empty log is removed, so that only a log with
+  // something to read (a warning, an error) is left beside the figures.
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(log_path, ec) && std::filesystem::file_size(log_path, ec) == 0 && !ec)
+    std::filesystem::remove(log_path, ec);
   return rc;
 }
 

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -110,9 +111,23 @@ OutputDirLock::OutputDirLock(const fs::path& dir) {
   fs::create_directories(dir, ec);
   if (ec) throw OutputError("cannot create the output directory " + dir.string() + " (" + ec.message() + ")");
   const fs::path lock = dir / ".abuopt.lock";
-  fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (fd_ < 0) fail(lock, "cannot create the lock file", errno);
-  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+  // The holder removes the file when it ends (no .abuopt.lock is left beside the outputs). A run
+  // that opened the file just before it was removed may then lock a file no longer in the folder:
+  // it checks that the locked file is still the one at the path, and starts again if not.
+  for (int attempt = 0;; ++attempt) {
+    fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) fail(lock, "cannot create the lock file", errno);
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) break;  // held by another run: the message below
+    struct stat held{}, named{};
+    if (attempt >= 100 || (::fstat(fd_, &held) == 0 && ::stat(lock.c_str(), &named) == 0 && held.st_ino == named.st_ino &&
+                           held.st_dev == named.st_dev)) {
+      const std::string pid = std::to_string(::getpid()) + "\n";
+      if (::ftruncate(fd_, 0) == 0) (void)write_all(fd_, pid.data(), pid.size());
+      return;
+    }
+    ::close(fd_);  // the file was removed by the run that held it: lock the new one
+  }
+  {
     const int e = errno;
     char buf[32] = {};
     const ssize_t n = ::pread(fd_, buf, sizeof buf - 1, 0);
@@ -127,12 +142,23 @@ OutputDirLock::OutputDirLock(const fs::path& dir) {
     }
     fail(lock, "cannot lock it", e);
   }
-  const std::string pid = std::to_string(::getpid()) + "\n";
-  if (::ftruncate(fd_, 0) == 0) (void)write_all(fd_, pid.data(), pid.size());
 }
 
 OutputDirLock::~OutputDirLock() {
-  if (fd_ >= 0) ::close(fd_);  // releases the flock; the file stays (harmless, reused next time)
+  if (fd_ < 0) return;
+  // Removed while still locked (see the constructor), then the lock released. After kill -9 the
+  // file stays; the next run locks and removes it.
+  // The locked file's path from the descriptor (the class keeps only the descriptor).
+  char path[4096];
+  const std::string link = "/proc/self/fd/" + std::to_string(fd_);
+  const ssize_t n = ::readlink(link.c_str(), path, sizeof path - 1);
+  if (n > 0) {
+    path[n] = '\0';
+    struct stat held{}, named{};
+    if (::fstat(fd_, &held) == 0 && ::stat(path, &named) == 0 && held.st_ino == named.st_ino && held.st_dev == named.st_dev)
+      (void)::unlink(path);
+  }
+  ::close(fd_);
 }
 
 }  // namespace abuopt

@@ -64,6 +64,33 @@ std::string yaml_value_text(const YAML::Node& n) {
   return e.c_str();
 }
 
+namespace {
+// As yaml_value_text, cut to about `max_chars` characters between elements ("{design: grid, grid: 32,
+// ...}"): the value of an unknown section in a message, which would otherwise be the whole section.
+std::string yaml_value_brief(const YAML::Node& n, std::size_t max_chars = 60) {
+  if (!n || n.IsScalar() || n.IsNull()) return yaml_value_text(n);
+  // Element by element, so that the cut falls between elements and the text stays readable.
+  const bool map = n.IsMap();
+  std::string out = map ? "{" : "[";
+  std::size_t i = 0;
+  for (auto it = n.begin(); it != n.end(); ++it, ++i) {
+    std::string item;
+    if (map) {
+      const std::string k = it->first.IsScalar() ? it->first.Scalar() : yaml_value_text(it->first);
+      item = k + ": " + (it->second.IsScalar() ? it->second.Scalar() : (it->second.IsMap() ? "{...}" : "[...]"));
+    } else {
+      item = it->IsScalar() ? it->Scalar() : (it->IsMap() ? "{...}" : "[...]");
+    }
+    if (i > 0 && out.size() + item.size() + 2 > max_chars) {
+      out += ", ...";
+      break;
+    }
+    out += (i ? ", " : "") + item;
+  }
+  return out + (map ? "}" : "]");
+}
+}  // namespace
+
 YamlReader::YamlReader(YAML::Node node, std::string path) : node_(std::move(node)), path_(std::move(path)) {
   if (node_ && !node_.IsNull() && !node_.IsMap()) {
     throw ConfigError(path_.empty() ? "<top level>" : path_, yaml_value_text(node_), "must be a mapping of keys");
@@ -323,7 +350,7 @@ void YamlReader::finish() const {
     if (!read_.count(k)) {
       // Every key asked for here (present or not) is a known key: the nearest one is the hint.
       const std::vector<std::string> known(read_.begin(), read_.end());
-      throw ConfigError(key_path(k), yaml_value_text(it->second),
+      throw ConfigError(key_path(k), yaml_value_brief(it->second),
                         "unknown key (misspelt, or not valid here)" + did_you_mean(k, known));
     }
   }

@@ -110,6 +110,11 @@ void describe_fields(FieldArchive& a, StartupProfile& p) {
   if (a.reading() || changed) p = StartupProfile(std::move(segments), f0);
 }
 
+void describe_fields(FieldArchive& a, FeedForward& f) {
+  a.field("enabled", f.enabled);
+  a.field("interval_s", f.interval_s, Rule::positive_at_most(kMaxSegmentDurationS));
+}
+
 void describe_fields(FieldArchive& a, MotorModel& m) {
   a.field("kind", m.kind, kMotorKindNames);
   a.field("omega_m_rad_s", m.omega_m_rad_s, Rule::positive());
@@ -119,6 +124,11 @@ void describe_fields(FieldArchive& a, MotorModel& m) {
   a.field("friction_feedback", m.friction_feedback);
   a.field("setpoint_mismatch", m.setpoint_mismatch);
   a.field("quantize_setpoint_1hz", m.quantize_setpoint_1hz);
+  a.nested("feedforward", m.feedforward);
+  if ((a.mode() == FieldArchive::Mode::Read || a.mode() == FieldArchive::Mode::Validate) && m.feedforward.enabled &&
+      m.kind != MotorKind::PI)
+    throw ConfigError((a.here().empty() ? "" : a.here() + ".") + "feedforward.enabled", "true",
+                      "needs kind: pi (the ideal motor's speed is the profile already)");
 }
 
 void describe_fields(FieldArchive& a, SimulationOptions& o) {

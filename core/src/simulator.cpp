@@ -73,6 +73,8 @@ Simulator::Simulator(SimulationSetup setup) : setup_(std::move(setup)) {
   if (o.stuck_integrator == StuckIntegrator::Exact && o.method == FrictionMethod::EventDriven &&
       setup_.motor.kind == MotorKind::Ideal && StuckForcingTable::supports(nd))
     stuck_table_ = StuckForcingTable::shared(setup_.profile, nd, end_time_s() * nd.omega_n);
+  if (setup_.motor.kind == MotorKind::PI && setup_.motor.feedforward.enabled)
+    reference_ = std::make_shared<const StartupProfile>(feedforward_setpoint(setup_.profile, setup_.motor));
 }
 
 Simulator::~Simulator() = default;
@@ -89,9 +91,9 @@ namespace {
 class Run {
  public:
   Run(const SimulationSetup& setup, double end_time_s, const std::vector<double>& beta0, const RunOverrides& ov,
-      std::vector<TrajectoryPoint>* trajectory, const StuckForcingTable* stuck_table)
-      : setup_(setup), p_(with_overrides(setup.abu, ov)), rs_(p_), lay_(rs_.lay()), trajectory_(trajectory) {
-    rs_.profile = &setup_.profile;
+      std::vector<TrajectoryPoint>* trajectory, const StuckForcingTable* stuck_table, const StartupProfile& reference)
+      : setup_(setup), ref_(reference), p_(with_overrides(setup.abu, ov)), rs_(p_), lay_(rs_.lay()), trajectory_(trajectory) {
+    rs_.profile = &ref_;  // the ideal motor's speed, or the PI drive's setpoint
     rs_.motor = setup_.motor;
     rs_.opt = setup_.options;
     rs_.mu = p_.friction_mu;
@@ -106,7 +108,7 @@ class Run {
     event_driven_ = rs_.opt.method == FrictionMethod::EventDriven;
     w_ = rs_.omega_n;
     t_end_ = end_time_s * w_;
-    t_profile_ = setup_.profile.duration_s() * w_;
+    t_profile_ = ref_.duration_s() * w_;
     out_.end_time_s = end_time_s;
     L_mm_ = p_.ball_track_radius_m * 1e3;
     traj_dt_ = rs_.opt.trajectory_interval_s * w_;
@@ -114,7 +116,7 @@ class Run {
       // The quantised reference is piecewise constant: its step times join the profile's
       // breakpoints as stop times, and it is held per interval (docs/model.md).
       rs_.ref_held = true;
-      for (double s : rs_.motor.reference_step_times_s(setup_.profile)) ref_steps_.push_back(s * w_);
+      for (double s : rs_.motor.reference_step_times_s(ref_)) ref_steps_.push_back(s * w_);
       hold_reference_after(0.0);
     }
 
@@ -165,6 +167,7 @@ class Run {
   RunOutcome finish(const Integrator& integ);
 
   const SimulationSetup& setup_;
+  const StartupProfile& ref_;  // setup_.profile, or its feed-forward setpoint (PI drive)
   AbuParameters p_;  // with the run's overrides applied
   RunState rs_;
   const StateLayout& lay_;
@@ -186,12 +189,12 @@ class Run {
 void Run::hold_reference_after(double tbar) {
   // next stop after tbar: a reference step or a profile breakpoint (or the profile's end)
   double next = std::max(t_end_, t_profile_) + 1.0;
-  for (double b : setup_.profile.breakpoints_s())
+  for (double b : ref_.breakpoints_s())
     if (b * w_ > tbar) next = std::min(next, b * w_);
   const auto it = std::upper_bound(ref_steps_.begin(), ref_steps_.end(), tbar);
   if (it != ref_steps_.end()) next = std::min(next, *it);
   const double mid = 0.5 * (tbar + next) / w_;
-  rs_.ref_hold_hz = rs_.motor.realised_reference_hz(setup_.profile.frequency_hz(mid));
+  rs_.ref_hold_hz = rs_.motor.realised_reference_hz(ref_.frequency_hz(mid));
 }
 
 // At a stop time with the quantised reference: the motor's W' (and with it every stuck ball's
@@ -218,7 +221,7 @@ void Run::reference_step(double t) {
 // tiny time with the rest state (forces then scale alike and the relative test works).
 void Run::choose_initial_modes() {
   const double w = w_;
-  const double first = setup_.profile.segments().empty() ? 1.0 : setup_.profile.segments()[0].duration_s;
+  const double first = ref_.segments().empty() ? 1.0 : ref_.segments()[0].duration_s;
   const double tiny = 1e-6 * first * w;
   std::vector<double> yprobe(y_);
   if (rs_.pi_motor) {
@@ -331,7 +334,7 @@ RunOutcome Run::execute() {
   if (event_driven_) set_root_offsets(rs_, t, y.data());
 
   std::vector<double> breaks;
-  for (double b : setup_.profile.breakpoints_s())
+  for (double b : ref_.breakpoints_s())
     if (b * w_ > 0 && b * w_ < t_end_) breaks.push_back(b * w_);
   if (!ref_steps_.empty()) {
     for (double b : ref_steps_)
@@ -457,7 +460,7 @@ RunOutcome Simulator::run(const std::vector<double>& beta0, const RunOverrides& 
   if (beta0.size() != setup_.abu.balls.size())  // API misuse: the caller sizes beta0 from ball_count()
     throw std::invalid_argument("Simulator::run: the ABU has " + std::to_string(setup_.abu.balls.size()) +
                                 " balls, but " + std::to_string(beta0.size()) + " initial angles were given");
-  Run run(setup_, end_time_s(), beta0, ov, trajectory, stuck_table_.get());
+  Run run(setup_, end_time_s(), beta0, ov, trajectory, stuck_table_.get(), reference_ ? *reference_ : setup_.profile);
   RunOutcome out = run.execute();
   out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return out;

@@ -84,12 +84,18 @@ ArchiveExportSummary export_archive(const std::string& archive_path, const std::
                        {"config", m.config},
                        {"config_hash", m.config_hash}});
 
+    // A metric named like a fixed column (the metric `runs`, the Monte Carlo's run count, beside the
+    // archive key `runs`) is written as metric_<name>: every column name is unique.
+    std::set<std::string> fixed = {"id", "timestamp", "runs", "ok", "objective", "wall_time_s", "message"};
+    for (const auto& n : p.variables) fixed.insert(n);
+    for (const auto& n : p.inequality) fixed.insert("g_" + n);
+    for (const auto& n : p.equality) fixed.insert("h_" + n);
     std::ostringstream csv;
     csv << "id,timestamp,runs,ok,objective";
     for (const auto& n : p.variables) csv << ',' << csv_field(n);
     for (const auto& n : p.inequality) csv << ',' << csv_field("g_" + n);
     for (const auto& n : p.equality) csv << ',' << csv_field("h_" + n);
-    for (const auto& n : metric_names) csv << ',' << csv_field(n);
+    for (const auto& n : metric_names) csv << ',' << csv_field(fixed.count(n) ? "metric_" + n : n);
     csv << ",wall_time_s,message\n";
 
     json jevals = json::array();

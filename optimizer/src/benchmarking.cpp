@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <random>
@@ -545,8 +546,9 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
   // Convergence curves of start 0: one data block per solver that has a curve, per problem. A
   // solver without a feasible point has no block (gnuplot's `index` counts the blocks that are
   // there, so an empty block would shift every later curve onto the wrong name); it is named in
-  // the key instead. A gap of 0 (f* reached) cannot be drawn on the log axis: the curve ends at
-  // its last positive value and the key says where f* was reached.
+  // the key instead. A gap of 0 (f* reached) cannot be drawn on the log axis: it is drawn on a floor
+  // line (a tenth of the smallest positive gap of the problem's curves), labelled "f* reached", so
+  // a solver that reaches f* keeps a visible curve to the end of its run.
   struct Curve {
     std::string solver;
     long index = -1;            // data block; -1: no feasible point
@@ -555,9 +557,20 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
   std::vector<std::string> pngs = {"data_profile.png", "performance_profile.png"};
   std::vector<std::string> conv_files;
   std::vector<std::vector<Curve>> curves(r.problems.size());
+  std::vector<double> floors(r.problems.size(), 1e-12);
   for (std::size_t p = 0; p < r.problems.size(); ++p) {
     const std::string name = "convergence_" + file_safe(r.problems[p]) + ".dat";
     OutFile f(dir / name, written);
+    const double scale = std::max(std::fabs(r.f_star[p]), 1.0);
+    double smallest = std::numeric_limits<double>::infinity();
+    for (const RunRecord& run : r.runs)
+      if (run.problem == r.problems[p] && run.start == 0)
+        for (const ConvergencePoint& c : run.convergence) {
+          const double gap = (c.best - r.f_star[p]) / scale;
+          if (gap > 0 && std::isfinite(gap)) smallest = std::min(smallest, gap);
+        }
+    const double floor_gap = std::isfinite(smallest) ? std::max(smallest / 10, 1e-300) : 1e-12;
+    floors[p] = floor_gap;
     long blocks = 0;
     for (const std::string& solver : r.solvers) {
       Curve curve;
@@ -565,12 +578,12 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
       std::ostringstream block;
       for (const RunRecord& run : r.runs) {
         if (run.problem != r.problems[p] || run.solver != solver || run.start != 0) continue;
-        const double scale = std::max(std::fabs(r.f_star[p]), 1.0);
         for (std::size_t i = 0; i < run.convergence.size(); ++i) {
-          const double gap = (run.convergence[i].best - r.f_star[p]) / scale;
+          double gap = (run.convergence[i].best - r.f_star[p]) / scale;
+          if (std::isnan(gap)) continue;
           if (!(gap > 0)) {
             if (curve.reached_at < 0) curve.reached_at = run.convergence[i].evaluation;
-            continue;
+            gap = floor_gap;  // drawn on the "f* reached" line
           }
           block << run.convergence[i].evaluation << " " << format_number(gap) << "\n";
           const long next = i + 1 < run.convergence.size() ? run.convergence[i + 1].evaluation : run.result.evaluations;
@@ -631,7 +644,9 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
       f << "set title " << plot_style::typeset("Convergence on " + plot_style::escape(r.problems[p]) +
                                                " (first start): best feasible (f - f^*) / max(|f^*|, 1)")
         << "\nset xlabel 'evaluations'\n"
-        << "set ylabel 'relative gap to f^*'\nplot ";
+        << "set ylabel 'relative gap to f^*'\nset yrange [" << format_number(floors[p] / 3) << ":*]\n"
+        << "plot " << format_number(floors[p]) << " with lines lc rgb '#7f7f7f' dt 2 lw 1 title "
+        << plot_style::literal("f* reached (gap 0, drawn at " + abuopt::format_significant(floors[p], 2) + ")") << ", ";
       for (std::size_t s = 0; s < curves[p].size(); ++s) {
         const Curve& c = curves[p][s];
         f << (s ? ", " : "");

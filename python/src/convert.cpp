@@ -61,8 +61,16 @@ YAML::Node to_yaml(const py::handle& value, const std::string& path) {
 YamlReader load_config(const py::handle& config) {
   if (py::isinstance<py::dict>(config)) return YamlReader(to_yaml(config, ""), "");
   py::object os = py::module_::import("os");
-  if (py::isinstance<py::str>(config) || py::hasattr(config, "__fspath__"))
-    return YamlReader::load_file(os.attr("fspath")(config).cast<std::string>());
+  if (py::isinstance<py::str>(config) || py::hasattr(config, "__fspath__")) {
+    const std::string path = os.attr("fspath")(config).cast<std::string>();
+    // A missing file is Python's FileNotFoundError (an OSError, as open() raises), not a ConfigError.
+    if (!os.attr("path").attr("exists")(path).cast<bool>()) {
+      PyErr_SetObject(PyExc_FileNotFoundError,
+                      py::make_tuple(2, "No such config file", path).ptr());  // errno ENOENT, strerror, filename
+      throw py::error_already_set();
+    }
+    return YamlReader::load_file(path);
+  }
   throw py::type_error("config must be a YAML file path (str or os.PathLike) or a dict, not " +
                        py::str(py::type::handle_of(config).attr("__name__")).cast<std::string>());
 }

@@ -10,7 +10,8 @@
 
 namespace abuopt::python {
 
-// A config given as a path (str or os.PathLike: the YAML file, read by YamlReader::load_file) or
+// A config given as a path (str or os.PathLike: the YAML file, read by YamlReader::load_file; a
+// missing file raises FileNotFoundError) or
 // as a dict (converted node by node into the YAML document the file would hold: mappings, lists,
 // bool, int, float (shortest round-trip text), str, None). Either way the same C++ readers read
 // it, so validation and messages are those of the command line.

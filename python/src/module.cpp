@@ -12,6 +12,8 @@
 #include <pybind11/stl.h>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/common/config_sections.hpp"
+#include "bindings.hpp"  // register_module_extras, register_archive
 #include "abuopt/core/batch_runner.hpp"
 #include "abuopt/core/equilibrium_set.hpp"
 #include "abuopt/core/monte_carlo.hpp"
@@ -35,7 +37,7 @@ py::dict outcome_dict(const RunOutcome& o) {
   py::dict d;
   d["status"] = to_string(o.status);
   d["message"] = o.message;
-  d["beta_final"] = o.beta_final;
+  d["beta_final"] = Array(static_cast<py::ssize_t>(o.beta_final.size()), o.beta_final.data());
   d["residual_imbalance"] = o.residual_imbalance_kgm;
   d["residual_imbalance_x"] = o.residual_imbalance_x_kgm;
   d["settled"] = o.settled;
@@ -54,7 +56,7 @@ py::dict simulate(const py::handle& config, const std::vector<double>& beta0) {
   YamlReader root = load_config(config);
   SimulationSetup setup = read_simulation_setup(root);
   if (root.has("montecarlo")) (void)read_monte_carlo_config(root, setup);
-  root.finish();
+  finish_config(root);
   const std::size_t n = setup.abu.balls.size();
   if (beta0.size() != n)
     throw ConfigError("beta0", std::to_string(beta0.size()) + " angles",
@@ -68,7 +70,7 @@ py::dict simulate(const py::handle& config, const std::vector<double>& beta0) {
     I0 = setup.abu.imbalance_kgm();
   }
   py::dict d = outcome_dict(o);
-  d["beta0"] = beta0;
+  d["beta0"] = Array(static_cast<py::ssize_t>(beta0.size()), beta0.data());
   d["imbalance_without_balls"] = I0;
   return d;
 }
@@ -93,7 +95,7 @@ py::dict montecarlo(const py::handle& config, std::optional<long long> runs, std
   YamlReader root(loaded.node(), "");
   SimulationSetup setup = read_simulation_setup(root);
   MonteCarloConfig cfg = read_monte_carlo_config(root, std::move(setup));
-  root.finish();
+  finish_config(root);
 
   MonteCarloResult result;
   MonteCarloStats stats;
@@ -163,8 +165,7 @@ py::dict equilibrium_set(const py::handle& config, double freq, std::size_t grid
   if (grid < 2 || grid > 4096) throw ConfigError("grid", std::to_string(grid), "must be in [2, 4096] (points per axis)");
   YamlReader root = load_config(config);
   const SimulationSetup setup = read_simulation_setup(root);
-  root.mark_read("eqset");  // the command line's section (frequencies, grid): given as arguments here
-  root.finish();
+  finish_config(root);
   const std::size_t nb = setup.abu.balls.size();
   if (nb < 2) throw ConfigError("abu.balls", std::to_string(nb) + " balls", "the equilibrium-set grid needs at least 2 balls");
   if (other_angles.size() != nb - 2)
@@ -224,7 +225,7 @@ class PyStartupProfileProblem {
     YamlReader optimizer = root.child("optimizer");
     YamlReader sao = root.child("sao");
     (void)opt::read_optimizer_options(optimizer, &sao);
-    root.finish();
+    finish_config(root);
     problem_ = std::make_unique<problems::StartupProfileProblem>(std::move(settings));
     vars_ = problem_->variables();
   }
@@ -289,31 +290,39 @@ class PyStartupProfileProblem {
 
 PYBIND11_MODULE(abuopt, m) {
   using namespace abuopt::python;
+  register_module_extras(m);  // first: the NumPy check (bindings.hpp)
   m.doc() =
       "abuopt: simulate an automatic balancing unit's startup, run Monte Carlo studies over the initial\n"
       "ball angles, compute equilibrium sets and evaluate the startup-profile design problem.\n"
-      "Configs are YAML paths or dicts with the command line's sections (docs/python.md).";
+      "Configs are YAML paths or dicts with the command line's sections (docs/python.md).\n"
+      "Units: SI. Imbalances (I_r, I_r,x, I) in kg m, angles in rad, frequencies in Hz, times in s,\n"
+      "amplitudes in mm (keys ending _mm). The optimisation problem's objective and metrics and the\n"
+      "archive's values are the optimiser's numbers, as `abuopt optimize` prints them (mean I_r in\n"
+      "1e-7 kg m; docs/optimize.md). Per-run results are NumPy arrays.";
   py::register_exception<abuopt::ConfigError>(m, "ConfigError", PyExc_ValueError);
+  register_archive(m);  // abuopt.Archive (archive_bindings.cpp)
 
   m.def("simulate", &simulate, py::arg("config"), py::kw_only(), py::arg("beta0"),
         "One startup from the initial ball angles beta0 [rad] (one per ball), as `abuopt simulate`.\n"
-        "Returns a dict: status, message, beta0, beta_final, residual_imbalance (|I_r|, kg m),\n"
-        "residual_imbalance_x (I_r,x), imbalance_without_balls, settled, settling_time, max_amplitude_mm,\n"
-        "end_time_s, events, steps, rhs_evaluations, wall_time_s.");
+        "Returns a dict: status, message, beta0 and beta_final (arrays [rad]), residual_imbalance (|I_r|,\n"
+        "kg m), residual_imbalance_x (I_r,x, kg m), imbalance_without_balls (I, kg m), settled,\n"
+        "settling_time [s], max_amplitude_mm, end_time_s, events, steps, rhs_evaluations, wall_time_s.\n"
+        "Units: SI (imbalances in kg m), as in every function of this module.");
   m.def("montecarlo", &montecarlo, py::arg("config"), py::kw_only(), py::arg("runs") = py::none(),
         py::arg("design") = py::none(), py::arg("seed") = py::none(), py::arg("threads") = py::none(),
         "Monte Carlo over initial ball angles, as `abuopt montecarlo`. runs/design/seed/threads override\n"
         "the config's montecarlo.runs/.design/.seed/.threads (checked as those keys). Returns a dict of\n"
-        "NumPy arrays, one entry per run: residual_imbalance, residual_imbalance_x, beta0 and beta_final\n"
-        "(runs x balls), status (str), ok, settled, settling_time, max_amplitude_mm, end_time_s,\n"
-        "friction_mu, imbalance_kgm, reused, events, steps, rhs_evaluations, wall_time_s; and 'summary':\n"
-        "the statistics as `abuopt montecarlo --json` prints them.");
+        "NumPy arrays, one entry per run: residual_imbalance and residual_imbalance_x [kg m], beta0 and\n"
+        "beta_final (runs x balls) [rad], status (str), ok, settled, settling_time [s], max_amplitude_mm,\n"
+        "end_time_s, friction_mu, imbalance_kgm [kg m], reused, events, steps, rhs_evaluations,\n"
+        "wall_time_s; and 'summary': the statistics as `abuopt montecarlo --json` prints them (kg m).\n"
+        "Units: SI (imbalances in kg m), as in every function of this module.");
   m.def("equilibrium_set", &equilibrium_set, py::arg("config"), py::arg("freq"), py::kw_only(),
         py::arg("grid") = 128, py::arg("other_angles") = std::vector<double>{},
         "The equilibrium set at constant speed freq [Hz] on a grid x grid over (beta_1, beta_2), as\n"
         "`abuopt eqset --freq`. Returns beta (grid), amplitude_mm and in_set (grid x grid, [i, j] at\n"
         "beta_1 = beta[i], beta_2 = beta[j]), margins (grid x grid x balls), coverage, speed_ratio,\n"
-        "natural_frequency_hz, mu, full_coverage_closed_form.");
+        "natural_frequency_hz, mu, full_coverage_closed_form. Units: beta in rad, amplitude in mm.");
 
   py::class_<PyStartupProfileProblem>(m, "StartupProfileProblem",
                                       "The startup-profile design problem of `abuopt optimize` (docs/optimize.md).")
@@ -325,11 +334,20 @@ PYBIND11_MODULE(abuopt, m) {
            "(checked as those keys): the in-sample initial conditions of every evaluation.")
       .def("evaluate", &PyStartupProfileProblem::evaluate, py::arg("x"),
            "objective (minimised), constraints (array, feasible when <= 0; +inf when the evaluation\n"
-           "failed), metrics (dict), ok, message. The last x is remembered (no second Monte Carlo).")
-      .def_property_readonly("names", &PyStartupProfileProblem::names)
-      .def_property_readonly("bounds", &PyStartupProfileProblem::bounds, "[(lower, upper)] per variable")
-      .def_property_readonly("scales", &PyStartupProfileProblem::scales)
-      .def_property_readonly("x0", &PyStartupProfileProblem::x0)
+           "failed), metrics (dict), ok, message. The last x is remembered (no second Monte Carlo).\n"
+           "Units: the optimiser's numbers, as `abuopt optimize` prints and archives them (mean I_r in\n"
+           "1e-7 kg m, %MI in %; docs/optimize.md); x in Hz and s.")
+      .def_property_readonly("names", &PyStartupProfileProblem::names,
+                             "variable names: f<k> end frequency of segment k [Hz], dt<k> its duration [s]")
+      .def_property_readonly("bounds", &PyStartupProfileProblem::bounds, "[(lower, upper)] per variable (Hz and s)")
+      .def_property_readonly("scales", [](const PyStartupProfileProblem& p) {
+        const std::vector<double> x = p.scales();
+        return Array(static_cast<py::ssize_t>(x.size()), x.data());
+      })
+      .def_property_readonly("x0", [](const PyStartupProfileProblem& p) {
+        const std::vector<double> x = p.x0();
+        return Array(static_cast<py::ssize_t>(x.size()), x.data());
+      }, "the initial point (array; Hz and s)")
       .def_property_readonly("constraint_names", &PyStartupProfileProblem::constraint_names)
       .def_property_readonly("identity", &PyStartupProfileProblem::identity)
       .def_property_readonly("evaluations", &PyStartupProfileProblem::evaluations,

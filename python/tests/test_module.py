@@ -54,7 +54,10 @@ def main():
     cli = cli_json("simulate", cfg, "--beta0", "0.5,2.0")
     for key in ["status", "beta_final", "residual_imbalance", "residual_imbalance_x", "imbalance_without_balls",
                 "settled", "settling_time", "max_amplitude_mm", "events", "steps", "rhs_evaluations", "end_time_s"]:
-        check(py[key] == cli[key], f"simulate {key}: module {py[key]} == CLI {cli[key]}")
+        same = np.array_equal(py[key], cli[key]) if isinstance(py[key], np.ndarray) else py[key] == cli[key]
+        check(same, f"simulate {key}: module {py[key]} == CLI {cli[key]}")
+    check(isinstance(py["beta_final"], np.ndarray) and isinstance(py["beta0"], np.ndarray),
+          "simulate returns arrays (beta0, beta_final) as montecarlo does")
 
     # 2. The same config as a dict (what the YAML file holds) gives the same run.
     config_dict = {
@@ -71,7 +74,7 @@ def main():
                        "friction": {"fixed": 0.02}},
     }
     pyd = abuopt.simulate(config_dict, beta0=np.array(beta0))
-    check(pyd["residual_imbalance"] == py["residual_imbalance"] and pyd["beta_final"] == py["beta_final"],
+    check(pyd["residual_imbalance"] == py["residual_imbalance"] and np.array_equal(pyd["beta_final"], py["beta_final"]),
           "simulate(dict) == simulate(YAML path)")
 
     # 3. Bad input: abuopt.ConfigError (a ValueError) naming the key, value and rule.
@@ -156,7 +159,43 @@ def main():
     i = p.constraint_names.index("startup_time")
     check(math.isclose(ev["constraints"][i], 19.0 / 20.0 - 1.0, rel_tol=1e-12), "startup_time constraint = 19/20 - 1")
 
-    # 7. The examples, quick mode (ABUOPT_QUICK=1 set by ctest).
+    # 7. What a newcomer expects of a NumPy/SciPy-style library: __version__, FileNotFoundError for a
+    # missing file, a config of several commands accepted by each (eqset ignores its montecarlo section).
+    ver = subprocess.run([a.cli, "--version"], capture_output=True, text=True).stdout
+    check(isinstance(abuopt.__version__, str) and abuopt.__version__ in ver,
+          f"abuopt.__version__ {abuopt.__version__!r} is the CLI's ({ver.strip()})")
+    try:
+        abuopt.simulate(os.path.join(a.work, "no_such.yaml"), beta0=beta0)
+        check(False, "a missing config file is FileNotFoundError")
+    except FileNotFoundError as f:
+        check(f.filename == os.path.join(a.work, "no_such.yaml"), f"a missing config file is FileNotFoundError: {f}")
+    eqm = abuopt.equilibrium_set(cfg, 29.0, grid=16)
+    check(eqm["in_set"].shape == (16, 16), "equilibrium_set reads montecarlo_final_profile.yaml (montecarlo section ignored)")
+
+    # 8. Archive: what `abuopt optimize` stored, read back, equal to `abuopt archive best --json`.
+    out = os.path.join(a.work, "opt")
+    r = subprocess.run([a.cli, "optimize", qcfg, "--max-evaluations", "4", "--threads", "2", "--out", out],
+                       capture_output=True, text=True)
+    check(r.returncode == 0, f"abuopt optimize quick.yaml --max-evaluations 4 (exit {r.returncode}) {r.stderr[-300:]}")
+    arc = abuopt.Archive(os.path.join(out, "archive.sqlite"))
+    probs = arc.problems()
+    check(len(probs) == 1 and probs[0]["runs"][0]["command"] == "optimize", f"Archive.problems: {len(probs)} problem")
+    ev = arc.evaluations()
+    n = len(ev["id"])
+    check(n >= 4 and ev["x"].shape == (n, 5) and ev["inequality"].shape == (n, len(probs[0]["inequality"])),
+          f"Archive.evaluations: {n} rows, x {ev['x'].shape}")
+    best = arc.best()
+    cli_best = cli_json("archive", "best", os.path.join(out, "archive.sqlite"))
+    check(best is not None and best["objective"] == cli_best["objective"] and best["id"] == cli_best["id"],
+          f"Archive.best == abuopt archive best: {best and best['objective']} vs {cli_best['objective']}")
+    feasible = ev["objective"][ev["feasible"]]
+    check(best["objective"] == feasible.min(), "Archive.best is the lowest feasible objective")
+    hist = arc.history()
+    check(hist["best_feasible"][-1] == best["objective"], "Archive.history ends at the best feasible objective")
+    few = arc.evaluations(where=[f"objective<={best['objective']}"])
+    check(len(few["id"]) >= 1 and np.all(few["objective"] <= best["objective"]), "Archive.evaluations(where=...) filters")
+
+    # 9. The examples, quick mode (ABUOPT_QUICK=1 set by ctest).
     env = dict(os.environ, ABUOPT_QUICK="1", MPLBACKEND="Agg")
     for script, args in [("montecarlo_histogram.py", ["--out", os.path.join(a.work, "histogram.png")]),
                          ("scipy_cobyla.py", [])]:

@@ -61,4 +61,43 @@ std::string comparison_table(const std::vector<ComparisonRow>& rows) {
   return os.str();
 }
 
+OutOfSampleVerdict out_of_sample_verdict(const std::vector<ComparisonRow>& rows) {
+  OutOfSampleVerdict v;
+  if (rows.size() < 4) return v;
+  const opt::Evaluation& best = rows[1].e;
+  const opt::Evaluation& report = rows[3].e;
+  struct Quantity {
+    const char* key;
+    const char* name;
+    int digits;
+  };
+  static const Quantity quantities[] = {{"ir_magnitude_mean", "mean |I_r|", 3},
+                                        {"ir_x_mean", "mean I_r,x", 3},
+                                        {"pct_mi_magnitude", "%MI |I_r|", 2},
+                                        {"pct_mi_x", "%MI I_r,x", 2}};
+  std::ostringstream os;
+  os << "  best vs report profile, out-of-sample (lower is better):\n";
+  bool any = false;
+  for (const Quantity& q : quantities) {
+    auto b = best.metrics.find(q.key);
+    auto r = report.metrics.find(q.key);
+    if (b == best.metrics.end() || r == report.metrics.end() || !std::isfinite(b->second) || !std::isfinite(r->second))
+      continue;
+    any = true;
+    const bool worse = b->second > r->second;
+    if (worse) v.worse.push_back(q.name);
+    os << "    " << std::left << std::setw(11) << q.name << std::right << std::fixed << std::setprecision(q.digits)
+       << std::setw(9) << b->second << " vs " << std::setw(9) << r->second << "  "
+       << (b->second < r->second ? "better" : worse ? "WORSE" : "equal") << "\n";
+  }
+  if (!any) return v;
+  if (!v.worse.empty()) {
+    os << "    WORSE than the report's profile on ";
+    for (std::size_t i = 0; i < v.worse.size(); ++i) os << (i ? ", " : "") << v.worse[i];
+    os << ": the objective optimised another quantity (objective.kind and .definition, docs/optimize.md)\n";
+  }
+  v.text = os.str();
+  return v;
+}
+
 }  // namespace abuopt

@@ -8,6 +8,7 @@
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/gnuplot.hpp"
+#include "abuopt/common/plot_style.hpp"
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/text.hpp"
 #include "abuopt/optimizer/evaluation_archive.hpp"
@@ -176,31 +177,29 @@ std::string write_pareto_outputs(const fs::path& dir, const problems::StartupPro
 
   const Gnuplot gp;
   const std::string ylabel = objective_label(st);
+  bool any_dominated = false;
+  for (const auto& p : r.points) any_dominated = any_dominated || (p.result.feasible && p.dominated);
+  // The one plot style (common/plot_style.hpp); text shown literally (noenhanced: "I_r,x").
   std::ostringstream body;
-  body << "set datafile separator ','\nset grid\nset key top right box opaque\n"
-       << "set title " << Gnuplot::quote("Pareto front: " + ylabel + " against startup time") << "\n"
-       << "set xlabel 'startup time T [s]'\nset ylabel " << Gnuplot::quote(ylabel) << "\n"
+  body << "set datafile separator ','\nset key top right box opaque\n"
+       << "set title " << plot_style::literal("Pareto front: " + ylabel + " against startup time") << "\n"
+       << "set xlabel " << plot_style::literal("startup time T [s]") << "\nset ylabel " << plot_style::literal(ylabel) << "\n"
        << "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n"
        << "plot 'pareto.csv' skip 1 using 2:(($3 == 1 && $4 == 0) ? $5 : NaN) with linespoints pt 7 ps 0.9 lw 2 "
-          "lc rgb '#3b6fb6' title 'front, in-sample (" << st.study.runs << " runs)', \\\n"
-       << "     'pareto.csv' skip 1 using 2:7:8 with yerrorbars pt 5 ps 0.7 lc rgb '#e07b00' title "
-          "'front points, out-of-sample (" << st.validation.runs << " runs, 95 % bars)', \\\n"
-       << "     'pareto.csv' skip 1 using 2:(($3 == 1 && $4 == 1) ? $5 : NaN) with points pt 6 ps 1.2 "
-          "lc rgb '#888888' title 'dominated (local optimum)', \\\n"
-       << "     'pareto_report_profile.csv' skip 1 every ::0::0 using 2:3:4 with yerrorbars pt 6 ps 1.8 lw 2 "
-          "lc rgb '#d62728' title '2003 report profile, in-sample', \\\n"
+          "lc rgb '" << plot_style::kBlue << "' title " << plot_style::literal("front, in-sample (" + std::to_string(st.study.runs) + " runs)") << ", \\\n"
+       << "     'pareto.csv' skip 1 using 2:7:8 with yerrorbars pt 5 ps 0.7 lc rgb '" << plot_style::kOrange << "' title "
+       << plot_style::literal("front points, out-of-sample (" + std::to_string(st.validation.runs) + " runs, 95 % bars)") << ", \\\n";
+  // "dominated" only when a point is (a key entry without a point misleads)
+  if (any_dominated)
+    body << "     'pareto.csv' skip 1 using 2:(($3 == 1 && $4 == 1) ? $5 : NaN) with points pt 6 ps 1.2 "
+            "lc rgb '" << plot_style::kGrey << "' title 'dominated (a local optimum)' noenhanced, \\\n";
+  body << "     'pareto_report_profile.csv' skip 1 every ::0::0 using 2:3:4 with yerrorbars pt 6 ps 1.8 lw 2 "
+          "lc rgb '" << plot_style::kRed << "' title '2003 report profile, in-sample (open circle)' noenhanced, \\\n"
        << "     'pareto_report_profile.csv' skip 1 every ::1::1 using 2:3:4 with yerrorbars pt 7 ps 1.4 lw 2 "
-          "lc rgb '#d62728' title '2003 report profile, out-of-sample'\n";
-  const std::string stem = "pareto";
+          "lc rgb '" << plot_style::kRed << "' title '2003 report profile, out-of-sample (filled circle)' noenhanced\n";
   const bool cairo = !gp.available() || gp.terminal() == "pngcairo";
-  std::ostringstream s;
-  s << "# written by abuopt pareto; run from this folder: gnuplot pareto.gp\n"
-    << "set terminal " << (cairo ? "pngcairo" : "png") << " noenhanced size 900,650\nset output 'pareto.png'\n"
-    << body.str();
-  if (cairo) s << "set terminal pdfcairo noenhanced size 9in,6.5in font ',9'\nset output 'pareto.pdf'\n" << body.str();
-  s << "set output\n";
   const fs::path script = dir / "pareto.gp";
-  write_file_atomic(script, s.str());
+  write_file_atomic(script, plot_style::figure_script("pareto", body.str(), 900, 650, cairo ? "pngcairo" : "png"));
   if (!gp.available()) return "pareto plot skipped: gnuplot not found (script " + script.string() + ")";
   std::error_code ec;
   fs::remove(dir / "pareto.png", ec);

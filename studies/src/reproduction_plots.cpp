@@ -65,21 +65,36 @@ PlotNote plot_trend(const Gnuplot& gp, const TableResult& t, const PlotRequest& 
     note.message = "skipped: no case with a value";
     return note;
   }
+  // The two series side by side at each value (their error bars would overlap where the axes'
+  // scales put them at the same height): shifted by +-12 % of the closest spacing of the values.
+  std::vector<double> values;
+  for (const CaseSummary& s : t.rows)
+    if (s.value && s.ok > 0) values.push_back(*s.value);
+  std::sort(values.begin(), values.end());
+  double spacing = 0;
+  for (std::size_t i = 1; i < values.size(); ++i)
+    if (values[i] > values[i - 1] && (spacing == 0 || values[i] - values[i - 1] < spacing)) spacing = values[i] - values[i - 1];
+  const std::string dx = csv_num(0.12 * spacing);
   const std::string data = Gnuplot::quote(req.name + ".csv");
+  // Which axis is which is said in words and by line and marker, not by colour alone: left axis
+  // mean I_r,x (solid line, filled circles), right axis %MI (dashed line, filled squares).
   std::ostringstream b;
   b << "set datafile separator ','\n"
     << "set datafile missing ''\n"
     << "set title " << plot_style::literal(table_heading(t.table)) << "\n"
     << "set xlabel " << plot_style::typeset(parameter_label(t.table)) << "\n"
-    << "set ylabel 'mean " << plot_style::kIrx << "'\n"
-    << "set y2label '" << plot_style::kPctMi << "'\n"
-    << "set ytics nomirror\nset y2tics\nset yrange [0:*]\nset y2range [0:*]\nset grid\nset key outside below\n"
-    << "set offsets graph 0.03, graph 0.03, 0, 0\n"
-    << "plot " << data << " skip 1 using 1:2:10:11 with yerrorlines lt 1 pt 7 title 'mean I_{r,x}, 95 % interval', \\\n"
-    << "     " << data << " skip 1 using 1:3:4:5 axes x1y2 with yerrorlines lt 4 pt 5 title '%MI, 95 % Wilson interval'";
+    << "set ylabel '← left axis: mean " << plot_style::kIrx << " (solid, ●)' tc lt 1\n"
+    << "set y2label 'right axis: " << plot_style::kPctMi << " (dashed, ■) →' tc lt 4\n"
+    << "set ytics nomirror tc lt 1\nset y2tics tc lt 4\nset yrange [0:*]\nset y2range [0:*]\nset grid\n"
+    << "set key outside below maxrows 2\n"
+    << "set offsets graph 0.04, graph 0.04, 0, 0\n"
+    << "plot " << data << " skip 1 using ($1-" << dx << "):2:10:11 with yerrorlines lt 1 pt 7 "
+    << "title 'mean I_{r,x} (left axis), 95 % interval', \\\n"
+    << "     " << data << " skip 1 using ($1+" << dx << "):3:4:5 axes x1y2 with yerrorlines lt 4 dt 2 pt 5 "
+    << "title '%MI (right axis), 95 % Wilson interval'";
   if (reference_points > 0)
-    b << ", \\\n     " << data << " skip 1 using 1:6 with points lt 1 pt 6 ps 1.8 title 'mean (2003 report)', \\\n"
-      << "     " << data << " skip 1 using 1:7 axes x1y2 with points lt 4 pt 4 ps 1.8 title '%MI (2003 report)'";
+    b << ", \\\n     " << data << " skip 1 using ($1-" << dx << "):6 with points lt 1 pt 6 ps 1.8 title 'mean (2003 report, left)', \\\n"
+      << "     " << data << " skip 1 using ($1+" << dx << "):7 axes x1y2 with points lt 4 pt 4 ps 1.8 title '%MI (2003 report, right)'";
   b << "\n";
   const std::string png = (dir / (req.name + ".png")).string();
   return finish_note(note, gp.run(b.str(), (dir / (req.name + ".gp")).string(), png, 900, 650));

@@ -160,7 +160,7 @@ std::string format_table_text(const TableResult& t) {
       const std::string mag_mi = num(s.pct_mi_mag, 1) + " [" + num(s.ci_mag[0], 1) + ", " + num(s.ci_mag[1], 1) + "]";
       const std::string ov = std::to_string(r.overlapping_without) + " / " + std::to_string(r.overlapping_with);
       std::snprintf(line, sizeof line, "  %-20s %5zu  %-22s %-26s %-9s %-20s %-11s %.1f s%s\n", s.label.c_str(), s.runs,
-                    (num(s.mean_x, 2) + " +- " + num(s.sem_x, 2)).c_str(), mi_text(s).c_str(), num(s.mean_mag, 2).c_str(),
+                    mean_text(s).c_str(), mi_text(s).c_str(), num(s.mean_mag, 2).c_str(),
                     mag_mi.c_str(), ov.c_str(), s.wall_time_s,
                     s.failed ? (" (" + std::to_string(s.failed) + " failed)").c_str() : "");
       os << line;

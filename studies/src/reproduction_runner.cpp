@@ -124,6 +124,9 @@ ReproductionReport run_reproduction(const std::vector<ReproductionTable>& tables
       line += " vs " + opt_num(c.reference.mean_1e7, 2) + ", %MI " + num(s.pct_mi_x, 2) + " vs ";
       line += opt_num(c.reference.pct_mi, 2) + (s.failed ? ", " + std::to_string(s.failed) + " failed" : "");
       line += "); total " + num(elapsed, 0) + " s";
+      // ETA from the rate of runs so far (cases differ in size: 256 or 1024 runs)
+      if (runs_before > 0 && runs_before < total_runs)
+        line += ", ETA " + num(elapsed / static_cast<double>(runs_before) * static_cast<double>(total_runs - runs_before), 0) + " s";
       log(line);
       if (table.contact_variant) {
         MonteCarloStudy cs = c.study;

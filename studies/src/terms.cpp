@@ -15,8 +15,10 @@ const std::vector<std::pair<std::string, std::string>>& report_terms() {
               "definition; [lo, hi] or \"95 % CI\" is its 95 % Wilson score interval."},
       {"%LC", "percentage of runs whose balls are not all sticking at the end time (twice the profile's "
               "duration unless set): lasting motion, \"limit cycles\"."},
-      {"+-", "after a mean: one standard error of that mean (over the runs); a 95 % interval is the mean "
-             "+- 1.96 standard errors (the error bars of the trend plots)."},
+      {"+-", "after a mean, in every abuopt printout: the 95 % half-width of that mean, 1.96 standard errors "
+             "(over the runs), so mean +- half-width is the 95 % interval (the error bars of every plot)."},
+      {"units", "imbalances (I, I_r, I_r,x, their means and maxima) are printed in 1e-7 kg m in tables, summaries "
+                "and plots; CSV and JSON files and the Python module give kg m (SI)."},
   };
   return t;
 }
@@ -43,6 +45,12 @@ std::string terms_text(const std::string& indent, std::size_t width) {
     os << line << "\n";
   }
   return os.str();
+}
+
+std::string terms_pointer() {
+  std::string names;
+  for (const auto& [term, text] : report_terms()) names += (names.empty() ? "" : ", ") + term;
+  return "Terms (" + names + "): abuopt --help";
 }
 
 std::string terms_markdown() {

@@ -105,14 +105,15 @@ TEST(SimulateCli, RunsConfigsWithAMontecarloSection) {
   EXPECT_NE(b.output.find("montecarlo.runz"), std::string::npos) << b.output;
 }
 
-// Every shipped design of the study (configs/studies/best/, issue 10: "abuopt simulate and abuopt
+// Every shipped design (configs/designs/ and what configs/studies/best/ still holds; issue 10: "abuopt simulate and abuopt
 // montecarlo run it as it is") runs unchanged: simulate with the command its header documents, and a Monte Carlo of 4 random
 // starts whose runs all end ok (the designs were validated on 1024; a config that no longer parses
 // or a profile that no longer simulates fails here).
 TEST(SimulateCli, EveryShippedStudyDesignRunsWithSimulateAndMontecarlo) {
   std::vector<std::string> files;
-  for (const auto& e : std::filesystem::directory_iterator(kConfigs + "studies/best"))
-    if (e.path().extension() == ".yaml") files.push_back(e.path().string());
+  for (const char* dir : {"designs", "studies/best"})
+    for (const auto& e : std::filesystem::directory_iterator(kConfigs + dir))
+      if (e.path().extension() == ".yaml") files.push_back(e.path().string());
   std::sort(files.begin(), files.end());
   ASSERT_GE(files.size(), 10u);  // the study ships one design per formulation and the front
   for (const std::string& f : files) {

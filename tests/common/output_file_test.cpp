@@ -127,5 +127,21 @@ TEST(OutputDirLock, ASecondHolderIsRefusedUntilTheFirstEnds) {
   fs::remove_all(d);
 }
 
+TEST(OutputDirLock, NoLockFileIsLeftBesideTheOutputs) {
+  const fs::path d = fresh_dir("output_file_test_lock_file");
+  {
+    const OutputDirLock lock(d);
+    EXPECT_TRUE(fs::exists(d / ".abuopt.lock"));
+  }
+  EXPECT_FALSE(fs::exists(d / ".abuopt.lock"));
+  // A file left by a killed run is taken over, and removed at the end.
+  std::ofstream(d / ".abuopt.lock") << "12345\n";
+  {
+    const OutputDirLock lock(d);
+  }
+  EXPECT_FALSE(fs::exists(d / ".abuopt.lock"));
+  fs::remove_all(d);
+}
+
 }  // namespace
 }  // namespace abuopt

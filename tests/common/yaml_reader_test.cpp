@@ -1,4 +1,5 @@
 #include "abuopt/common/yaml_reader.hpp"
+#include "abuopt/common/config_sections.hpp"
 
 #include <gtest/gtest.h>
 
@@ -56,4 +57,28 @@ TEST(YamlReader, WrongTypeAndMissingAndChoice) {
 TEST(YamlReader, NonScalarKeyIsAnUnknownKeyNotAnInternalError) {
   auto r = YamlReader::load_string("? [a, b]\n: 1\n");
   EXPECT_EQ(error_of([&] { r.finish(); }), "[a, b] = 1: unknown key (misspelt, or not valid here)");
+}
+
+// A reader of some sections of a config (simulate, eqset) accepts the others a normal config carries
+// and still refuses a misspelt section, with the known sections as hints.
+TEST(ConfigSections, OtherCommandsSectionsAreAcceptedUnread) {
+  auto r = YamlReader::load_string("abu: {friction_mu: 0.02}\nmontecarlo: {design: grid, grid: 32}\nsweep: {}\n");
+  r.child("abu").get_double("friction_mu");
+  EXPECT_NO_THROW(abuopt::finish_config(r));
+  EXPECT_NE(error_of([&] { r.finish(); }).find("montecarlo = {design: grid, grid: 32}: unknown key"), std::string::npos);
+}
+
+TEST(ConfigSections, MisspeltSectionIsRefusedWithAHint) {
+  auto r = YamlReader::load_string("abu: {}\nmontecalro: {design: grid}\n");
+  r.child("abu");
+  EXPECT_EQ(error_of([&] { abuopt::finish_config(r); }),
+            "montecalro = {design: grid}: unknown key (misspelt, or not valid here); did you mean 'montecarlo'?");
+}
+
+TEST(YamlReader, AnUnknownSectionIsShownBriefly) {
+  auto r = YamlReader::load_string("mc: {design: grid, grid: 32, runs: 1024, seed: 1, threads: 0, friction: {fixed: 0.02}}\n");
+  EXPECT_EQ(error_of([&] { r.finish(); }),
+            "mc = {design: grid, grid: 32, runs: 1024, seed: 1, threads: 0, ...}: unknown key (misspelt, or not valid here)");
+  auto q = YamlReader::load_string("l: [1, [2, 3], {a: 1}]\n");
+  EXPECT_EQ(error_of([&] { q.finish(); }), "l = [1, [...], {...}]: unknown key (misspelt, or not valid here)");
 }

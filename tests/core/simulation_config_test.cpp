@@ -57,6 +57,9 @@ SimulationSetup unusual_setup() {
   s.motor.friction_feedback = false;
   s.motor.setpoint_mismatch = true;
   s.motor.quantize_setpoint_1hz = true;
+  // enabled stays false: true is refused with kind: ideal, which the perturbation test sets
+  // (tests/core/feedforward_test.cpp reads it true)
+  s.motor.feedforward.interval_s = 0.02;
   s.options.method = FrictionMethod::SwitchModel;
   s.options.backend = IntegratorBackend::ArkodeErk;
   s.options.erk_table = "ARKODE_VERNER_8_5_6";

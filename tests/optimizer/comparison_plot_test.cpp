@@ -3,6 +3,8 @@
 // is checked against the run it belongs to.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -31,7 +33,8 @@ opt::RunRecord run(const std::string& solver, std::vector<std::pair<long, double
 }
 
 // Four solvers: the second never found a feasible point (no curve), the third reaches f* after
-// positive gaps, the fourth is at f* from its first feasible point (nothing to draw on a log axis).
+// positive gaps, the fourth is at f* from its first feasible point (a gap of 0: drawn on the floor
+// line of the log axis, a tenth of the smallest positive gap).
 opt::ComparisonResult three_solvers(const std::string& label_of_first) {
   opt::ComparisonResult r;
   r.problems = {"hs071"};
@@ -87,10 +90,16 @@ TEST(ComparisonPlots, EveryConvergenceCurveIsDrawnUnderItsOwnSolver) {
     const std::string title = (*it)[2];
     index_of[title.substr(0, title.find(" ("))] = std::stol((*it)[1]);
   }
-  ASSERT_EQ(index_of.size(), 2u) << script;
-  ASSERT_TRUE(index_of.count("Ipopt") && index_of.count("SLSQP")) << script;
+  ASSERT_EQ(index_of.size(), 3u) << script;
+  ASSERT_TRUE(index_of.count("Ipopt") && index_of.count("SLSQP") && index_of.count("IPOPT")) << script;
+  // The smallest positive gap is SLSQP's 17.17 - 17: the floor is a tenth of it.
+  const double floor_gap = 0.17 / 17.0 / 10.0;
+  EXPECT_NE(script.find("f* reached (gap 0, drawn at 0.001)"), std::string::npos) << script;
+  const auto& ipopt = data.at(static_cast<std::size_t>(index_of.at("IPOPT")));
+  ASSERT_FALSE(ipopt.empty());
+  for (const auto& [x, y] : ipopt) EXPECT_NEAR(y, floor_gap, 1e-15) << "IPOPT is at f* from evaluation 4";
   for (const opt::RunRecord& run : r.runs) {
-    if (run.convergence.empty() || run.convergence.front().best <= 17.0) continue;  // nothing drawable
+    if (run.convergence.empty() || run.convergence.front().best <= 17.0) continue;  // checked above
     const auto& block = data.at(static_cast<std::size_t>(index_of.at(run.solver)));
     // The first point of the block is the run's first point, with the gap (f - f*) / max(|f*|, 1).
     ASSERT_FALSE(block.empty()) << run.solver;
@@ -100,11 +109,11 @@ TEST(ComparisonPlots, EveryConvergenceCurveIsDrawnUnderItsOwnSolver) {
     for (const auto& [x, y] : block) {
       bool found = false;
       for (const auto& c : run.convergence)
-        found = found || std::abs(y - (c.best - 17.0) / 17.0) < 1e-12;
+        found = found || std::abs(y - std::max((c.best - 17.0) / 17.0, floor_gap)) < 1e-12;
       EXPECT_TRUE(found) << run.solver << ": " << x << " " << y;
     }
   }
-  // The solver without a feasible point is named, with no data; the zero gap is not drawn.
+  // The solver without a feasible point is named, with no data; a zero gap is on the floor (> 0).
   EXPECT_NE(script.find("NaN with lines lt 2 title 'BOBYQA (no feasible point)'"), std::string::npos) << script;
   EXPECT_NE(script.find("title 'BOBYQA (no feasible point)' noenhanced"), std::string::npos) << script;
   EXPECT_NE(script.find("SLSQP (reaches f* at evaluation 9)"), std::string::npos) << script;

@@ -43,7 +43,7 @@ def main():
         cfg = os.path.join(tmp, "design.yaml")
         with open(cfg, "w") as f:
             f.write(CONFIG)
-        best = os.path.join(ROOT, "configs", "studies", "best", "contact_best_mu03_deepshake_6balls.yaml")
+        best = os.path.join(ROOT, "configs", "designs", "mu03_6balls_17s.yaml")
         r = subprocess.run([sys.executable, SCRIPT, cfg, best, "--out", os.path.join(tmp, "out")],
                            capture_output=True, text=True)
         dat = os.path.join(tmp, "out", "profiles.dat")
@@ -51,7 +51,7 @@ def main():
         check(r.returncode == 0 and len(blocks) == 3 and blocks[0].startswith("# 2003 profile")
               and "design: 11.84 s, peak |f'| 40.0 Hz/s" in r.stdout
               and "lowest speed after reaching 28 Hz 22.50 Hz" in r.stdout
-              and "contact_best_mu03_deepshake_6balls: 17.25 s, peak |f'| 49.5 Hz/s (311.0 rad/s^2)" in r.stdout,
+              and "mu03_6balls_17s: 17.25 s, peak |f'| 49.5 Hz/s (311.0 rad/s^2)" in r.stdout,
               f"two configs and the 2003 profile written and summarised (status {r.returncode}) {r.stderr[-300:]}")
         bad = os.path.join(tmp, "bad.yaml")
         with open(bad, "w") as f:

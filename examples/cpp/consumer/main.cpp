@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/common/config_sections.hpp"
 #include "abuopt/common/yaml_reader.hpp"
 #include "abuopt/core/simulation_config.hpp"
 #include "abuopt/core/simulator.hpp"
@@ -21,15 +22,15 @@ int main(int argc, char** argv) {
   try {
     abuopt::YamlReader root = abuopt::YamlReader::load_file(argv[1]);
     const abuopt::SimulationSetup setup = abuopt::read_simulation_setup(root);
-    root.mark_read("montecarlo");  // the Monte Carlo section is not used here
-    root.finish();
+    abuopt::finish_config(root);  // the other sections (montecarlo, ...) are not used here
     std::vector<double> beta0 = {0.5, 2.0};
     if (argc == 4) beta0 = {std::atof(argv[2]), std::atof(argv[3])};
     const abuopt::Simulator sim(setup);
     const abuopt::RunOutcome o = sim.run(beta0, {});
     std::cout << "status " << abuopt::to_string(o.status) << "\n"
-              << "residual imbalance |I_r| = " << o.residual_imbalance_kgm << " kg m, I_r,x = "
-              << o.residual_imbalance_x_kgm << " kg m (without balls " << setup.abu.imbalance_kgm() << " kg m)\n";
+              << "residual imbalance |I_r| = " << o.residual_imbalance_kgm * 1e7 << "e-7 kg m, I_r,x = "
+              << o.residual_imbalance_x_kgm * 1e7 << "e-7 kg m (without balls " << setup.abu.imbalance_kgm() * 1e7
+              << "e-7 kg m)\n";
     return o.ok() ? 0 : 3;
   } catch (const abuopt::ConfigError& e) {
     std::cerr << "abuopt_consumer: " << e.what() << "\n";

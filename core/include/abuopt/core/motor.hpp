@@ -7,6 +7,9 @@
 //       = T_b + sum_i fw_i l_i          (friction feedback from the balls; optional)
 //   with the setpoint mismatch of the drive f_real = f_target - (f_target + 1)/64 (eq 2.1) and
 //   1 Hz setpoint quantisation as options.
+// - Feed-forward (PI only, optional): the profile is the speed WANTED of the disc; the drive is
+//   given the setpoint that makes its real speed follow it (feedforward_setpoint below,
+//   docs/pi_feedforward.md).
 #include <string>
 #include <vector>
 
@@ -15,6 +18,13 @@
 namespace abuopt {
 
 enum class MotorKind { Ideal, PI };
+
+// The feed-forward setpoint of the PI drive: with it the profile is the speed wanted of the disc,
+// and the drive is steered with the setpoint computed from it, sampled every interval_s.
+struct FeedForward {
+  bool enabled = false;
+  double interval_s = 0.01;  // the steering program's update interval (a setpoint every 10 ms)
+};
 
 struct MotorModel {
   MotorKind kind = MotorKind::Ideal;
@@ -26,6 +36,7 @@ struct MotorModel {
   bool friction_feedback = true;       // include sum_i fw_i l_i
   bool setpoint_mismatch = false;      // apply eq 2.1 to the reference
   bool quantize_setpoint_1hz = false;  // round the reference frequency to whole Hz
+  FeedForward feedforward;             // PI only: steer with the feed-forward setpoint of the profile
   // Reference frequency the drive actually follows for a target frequency (mismatch/quantisation).
   double realised_reference_hz(double target_hz) const;
   // With quantize_setpoint_1hz the realised reference is piecewise constant: it jumps where the
@@ -37,5 +48,24 @@ struct MotorModel {
 };
 
 std::string to_string(MotorKind k);
+
+// The feed-forward setpoint that makes the PI drive's real speed follow `wanted` (the design made
+// for the ideal motor). With e = Omega_ref - Omega and delta' = e the drive is
+//   Omega' = 2 xi w e + w^2 delta - (T_b/J) sat(Omega/0.1)   (the balls' torque, ~1e-3: neglected),
+// so for Omega = Omega_d = 2 pi f(t):
+//   2 xi w delta' + w^2 delta = Omega_d' + (T_b/J) sat(Omega_d/0.1),  delta(0) = 0,
+//   Omega_ref = Omega_d + delta'
+// (a stable first-order ODE, pole -w/(2 xi); RK4 with interval_s/100 steps). The setpoint is sampled
+// at the end of every interval (interval_s rounded so that a whole number fits the profile) and
+// returned as inclined-sine segments between the samples, the value the drive is GIVEN:
+// - with quantize_setpoint_1hz the samples are whole Hz chosen by first-order error feedback (their
+//   running sum follows the exact setpoint's; the loop, 0.35 Hz, averages the +-1 Hz dither);
+// - with setpoint_mismatch the samples are pre-distorted by the inverse of eq 2.1,
+//   f_target = (64 f + 1)/63, so that the drive's realised reference is the setpoint.
+// After the profile the drive holds the last sample. Throws ConfigError ("motor.feedforward")
+// when the profile does not start from rest, the motor is not PI or feed-forward is off, the
+// interval is not in (0, duration], or a sample falls outside [0, kMaxFrequencyHz] (a design too
+// fast for the loop).
+StartupProfile feedforward_setpoint(const StartupProfile& wanted, const MotorModel& motor);
 
 }  // namespace abuopt

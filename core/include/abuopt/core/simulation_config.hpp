@@ -24,6 +24,7 @@ void describe_fields(FieldArchive& a, Ball& b);
 void describe_fields(FieldArchive& a, AbuParameters& p);
 void describe_fields(FieldArchive& a, InclinedSineSegment& s);
 void describe_fields(FieldArchive& a, StartupProfile& p);
+void describe_fields(FieldArchive& a, FeedForward& f);
 void describe_fields(FieldArchive& a, MotorModel& m);
 void describe_fields(FieldArchive& a, SimulationOptions& o);
 // The four sections abu, profile, motor, simulation.

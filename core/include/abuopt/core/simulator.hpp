@@ -100,6 +100,9 @@ class Simulator {
   // The forcing integrals of the exact stuck-phase propagator, shared by all runs (null when the
   // Runge-Kutta path is used).
   std::shared_ptr<const detail::StuckForcingTable> stuck_table_;
+  // What the PI drive is steered with: the profile, or its feed-forward setpoint
+  // (motor.feedforward, computed once here).
+  std::shared_ptr<const StartupProfile> reference_;
 };
 
 }  // namespace abuopt

@@ -38,4 +38,14 @@ OutOfSampleComparison compare_out_of_sample(const problems::StartupProfileProble
 // amplitude, startup time, failed runs).
 std::string comparison_table(const std::vector<ComparisonRow>& rows);
 
+// The best design against the report's profile, both out-of-sample, on each definition of the
+// residual imbalance (mean |I_r|, mean I_r,x, %MI of each): an optimiser that improved one
+// definition may have made the other worse, and a summary that names one would hide it.
+struct OutOfSampleVerdict {
+  std::string text;                // "  best vs report profile, out-of-sample: mean |I_r| 7.1 vs 8.0 better; ..."
+  std::vector<std::string> worse;  // the quantities that got worse ("mean I_r,x"), empty when none
+};
+// `rows` as compare_out_of_sample returns them (rows[1]: best out-of-sample, rows[3]: the report's).
+OutOfSampleVerdict out_of_sample_verdict(const std::vector<ComparisonRow>& rows);
+
 }  // namespace abuopt
