@@ -10,6 +10,8 @@ packages=(
   libyaml-cpp-dev        # study configs
   libnlopt-dev libnlopt-cxx-dev  # NLopt optimisers (C API + C++ wrapper; the CMake config is in libnlopt-dev)
   coinor-libipopt-dev    # Ipopt
+  libpagmo-dev           # pagmo2 optimisers (CMA-ES, xNES, SADE, PSO; links TBB and Boost.Serialization)
+  python3-optuna         # examples/python/optuna_study.py (TPE, CMA-ES samplers; exits 0 without it)
   libsqlite3-dev         # evaluation archive
   libopenmpi-dev openmpi-bin  # MPI across ranks (parallel/, option ABUOPT_MPI; docs/cluster.md)
   libcli11-dev           # command line parsing

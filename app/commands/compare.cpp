@@ -22,6 +22,9 @@
 //   solvers:
 //     - {label: SAO, algorithm: sao, sao: {...}}
 //     - {label: COBYLA, algorithm: cobyla, options: {...}}   # options: the optimizer: keys
+//     - {label: CMA-ES, algorithm: pagmo_cmaes}             # pagmo2: pagmo_cmaes/xnes/sade/pso
+//     - {label: Optuna-TPE, external: DIR}    # runs made elsewhere: DIR/<problem>/start<k>.csv
+//                                             # (examples/python/optuna_study.py; docs/benchmarks.md)
 //
 // Resumable: every run keeps its evaluations in OUT/archive/<problem>/start<k>-<solver>.sqlite (and
 // the validations in OUT/archive/<problem>/validation.sqlite); the same command with the same --out

@@ -23,6 +23,7 @@
 #include "abuopt/optimizer/optimizer_options.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
 #include "convert.hpp"
+#include "problem_bindings.hpp"
 
 namespace py = pybind11;
 
@@ -352,4 +353,6 @@ PYBIND11_MODULE(abuopt, m) {
       .def_property_readonly("evaluations", &PyStartupProfileProblem::evaluations,
                              "Monte Carlo evaluations done (repeats of the last x not counted)")
       .def("startup_time_s", &PyStartupProfileProblem::startup_time_s, py::arg("x"));
+
+  register_problem_bindings(m);  // BatchProblem (problem_bindings.cpp)
 }
