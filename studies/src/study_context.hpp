@@ -35,9 +35,16 @@ struct StudyContext {
   void log(const std::string& line) const;
   bool stop() const;
   void tick(long n = 1);
-  // Settings of a Monte Carlo on a fresh sample: the choice's settings with this seed and run
-  // count (0: keep), the envelope as given or (map point) friction and imbalance fixed.
-  problems::StartupProfileSettings fresh(std::size_t balls, std::uint64_t seed, std::size_t runs) const;
+  // A fresh sample (this seed, this run count; 0: the sampling's): the baseline evaluated on it
+  // and the choice's settings on it, whose relative constraints hold against that evaluation (the
+  // baseline on the same sample, not the in-sample one).
+  struct Fresh {
+    problems::StartupProfileSettings settings;
+    opt::Evaluation baseline;
+  };
+  Fresh fresh(std::size_t balls, std::uint64_t seed, std::size_t runs);
+  // The baseline's settings on a sample (seed, runs; 0: keep).
+  problems::StartupProfileSettings baseline_sample(std::uint64_t seed, std::size_t runs) const;
   // Evaluates a profile under `s` through the archive (key: the problem identity and the profile).
   opt::Evaluation evaluate_profile(const problems::StartupProfileSettings& s, const StartupProfile& p);
   // The settings of the baseline's ABU (the abu section as given).

@@ -56,6 +56,17 @@ std::string drive_text(const MotorModel& m) {
   return t + ")";
 }
 
+std::string verdict_text(const ValidationResult& v) {
+  const Interval& q = v.ratio_mean_ir;
+  const std::string n = std::to_string(q.samples) + " fresh samples";
+  if (q.samples < 2) return "One fresh sample: no interval; the ratio " + sig3(q.mean) + " is a single estimate.";
+  if (q.hi < 1.0)
+    return "Better than the baseline: the mean |I_r| is " + sig3(100 * (1 - q.mean)) + " % lower (95 % interval of the ratio below 1 on " + n + ").";
+  if (q.lo > 1.0)
+    return "Worse than the baseline: the mean |I_r| is " + sig3(100 * (q.mean - 1)) + " % higher (95 % interval of the ratio above 1 on " + n + ").";
+  return "No difference from the baseline that " + n + " can tell (the 95 % interval of the ratio contains 1).";
+}
+
 }  // namespace detail
 
 namespace {
@@ -142,7 +153,8 @@ std::string markdown(const StudyFile& f, const StudyResult& r) {
                                                          {"amplitude_max_mm", "peak amplitude [mm]"}};
       for (const auto& [k, label] : rows)
         md << "| " << label << " | " << interval_text(v.design.at(k)) << " | " << interval_text(v.baseline.at(k)) << " |\n";
-      md << "\nRatio of mean |I_r| (recommended / baseline): " << interval_text(v.ratio_mean_ir) << ".\n\n";
+      md << "\nRatio of mean |I_r| (recommended / baseline): " << interval_text(v.ratio_mean_ir) << ". "
+         << verdict_text(v) << "\n\n";
     }
   }
   if (!r.notes.empty()) {

@@ -2,6 +2,7 @@
 // answers first (the recommended design against the baseline, with intervals, and its conditions),
 // then shows the profiles, the ratio to the baseline over the envelope, the convergence of every
 // stage and every design's table.
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -70,7 +71,8 @@ std::string study_html(const StudyFile& f, const StudyResult& r) {
         h << "<tr><td>" << label << "</td><td class=\"num\">" << interval_text(v.design.at(k))
           << "</td><td class=\"num\">" << interval_text(v.baseline.at(k)) << "</td></tr>\n";
       h << "<tr><td><b>ratio of mean |I<sub>r</sub>|</b></td><td class=\"num\" colspan=\"2\"><b>"
-        << interval_text(v.ratio_mean_ir) << "</b> (recommended / baseline)</td></tr></table>\n";
+        << interval_text(v.ratio_mean_ir) << "</b> (recommended / baseline)</td></tr></table>\n<p><b>"
+        << esc(verdict_text(v)) << "</b></p>\n";
     } else {
       h << "<p>In sample: objective " << sig3(rec->in_sample.objective) << " against the baseline's "
         << sig3(r.baseline.objective) << " (no validate stage: no intervals on fresh samples).</p>\n";
@@ -88,6 +90,19 @@ std::string study_html(const StudyFile& f, const StudyResult& r) {
 
   // ---- the profiles ----
   std::vector<SvgSeries> prof;
+  {  // the natural frequency of the ABU as given, as a dotted level
+    const double fn = f.base.setup.abu.natural_frequency_hz();
+    double t_end = f.base.setup.profile.duration_s();
+    for (const auto& d : r.designs) t_end = std::max(t_end, d.profile.duration_s());
+    SvgSeries level;
+    level.name = "natural frequency " + sig3(fn) + " Hz";
+    level.color = "#999999";
+    level.width = 1.0;
+    level.dashed = true;
+    level.x = {0.0, t_end};
+    level.y = {fn, fn};
+    prof.push_back(level);
+  }
   prof.push_back(speed_series(f.base.setup.profile, "baseline", "#444444", 2.0, true));
   std::size_t colour = 0;
   for (std::size_t i = 0; i < r.designs.size(); ++i) {
@@ -106,7 +121,8 @@ std::string study_html(const StudyFile& f, const StudyResult& r) {
     const ValidationResult& v = r.validation;
     h << "<h2>Ratio to the baseline over the envelope</h2>\n<figure>"
       << svg_heatmap("mean |I_r| of the recommended design / the baseline's", "friction mu",
-                     "imbalance mass change (relative)", v.map_mu, v.map_imbalance, v.map_ratio, 1.0, 720, 80 + 50 * static_cast<int>(v.map_imbalance.size()))
+                     "imbalance change", v.map_mu, v.map_imbalance, v.map_ratio, 1.0, 720,
+                     std::max(220, 80 + 50 * static_cast<int>(v.map_imbalance.size())))
       << "<figcaption>Each cell: a Monte Carlo of " << v.map_runs
       << " runs with the friction and the imbalance fixed at that point (same initial angles for both profiles). "
       << "Below 1 (blue): the design is better than the baseline there.</figcaption></figure>\n";

@@ -17,6 +17,8 @@ std::string sig3(double v);
 double metric(const opt::Evaluation& e, const std::string& key);
 // The drive in words: "ideal motor" or "PI drive (1 Hz setpoints, ...)".
 std::string drive_text(const MotorModel& m);
+// One sentence: better than the baseline, worse, or no difference the samples can tell.
+std::string verdict_text(const ValidationResult& v);
 // The HTML report (study_report_html.cpp).
 std::string study_html(const StudyFile& f, const StudyResult& r);
 

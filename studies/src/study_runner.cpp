@@ -26,6 +26,13 @@ namespace {
 constexpr double kTolerance = 1e-6;  // on the relative constraints g = value / bound - 1
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+// 4 significant digits for the log
+std::string g4(double v) {
+  std::ostringstream os;
+  os << std::setprecision(4) << v;
+  return os.str();
+}
+
 std::string hex16(std::uint64_t v) {
   std::ostringstream os;
   os << std::hex << std::setw(16) << std::setfill('0') << v;
@@ -44,13 +51,23 @@ void StudyContext::tick(long n) {
   if (options.progress) options.progress(done, std::max(done, total));
 }
 
-problems::StartupProfileSettings StudyContext::fresh(std::size_t balls, std::uint64_t seed, std::size_t runs) const {
-  problems::StartupProfileSettings s = settings_of_choice(file, balls, result.baseline.metrics);
+problems::StartupProfileSettings StudyContext::baseline_sample(std::uint64_t seed, std::size_t runs) const {
+  problems::StartupProfileSettings s = baseline_settings();
   s.study.seed = seed;
   s.study.design.seed = seed;
   if (runs > 0) s.study.runs = runs;
-  if (options.threads) s.threads = *options.threads;
   return s;
+}
+
+StudyContext::Fresh StudyContext::fresh(std::size_t balls, std::uint64_t seed, std::size_t runs) {
+  Fresh r;
+  r.baseline = evaluate_profile(baseline_sample(seed, runs), file.base.setup.profile);
+  r.settings = settings_of_choice(file, balls, r.baseline.metrics);
+  r.settings.study.seed = seed;
+  r.settings.study.design.seed = seed;
+  if (runs > 0) r.settings.study.runs = runs;
+  if (options.threads) r.settings.threads = *options.threads;
+  return r;
 }
 
 problems::StartupProfileSettings StudyContext::baseline_settings() const {
@@ -163,7 +180,7 @@ void run_optimiser_stage(StudyContext& c, const StageSpec& stage, bool from_best
     c.result.designs.push_back(d);
     std::ostringstream done;
     done << "  " << tr.reason << " after " << r.evaluations << " evaluations (" << r.archive_hits
-         << " from the archive): objective " << format_number(d.in_sample.objective)
+         << " from the archive): objective " << g4(d.in_sample.objective)
          << (d.robust_feasible ? " (feasible)" : " (NOT feasible)");
     c.log(done.str());
   }
@@ -196,7 +213,7 @@ StudyResult run_study(const StudyFile& f, const StudyRunOptions& o) {
     if (s.kind == StageKind::Global || s.kind == StageKind::Local)
       optimiser += s.optimizer.max_evaluations * static_cast<long>(f.ball_counts.size());
     else if (s.kind == StageKind::Replicate)
-      other += static_cast<long>(s.seeds.size() * f.ball_counts.size());
+      other += static_cast<long>(s.seeds.size() * (f.ball_counts.size() + 1));
     else
       other += static_cast<long>(2 * s.seeds.size() + 2 * s.map_friction_mu.size() * s.map_imbalance_relative.size());
   }
@@ -209,10 +226,10 @@ StudyResult run_study(const StudyFile& f, const StudyRunOptions& o) {
     throw ConfigError("baseline", "<profile>", "its Monte Carlo failed (" + result.baseline.message + ")");
   {
     std::ostringstream os;
-    os << "baseline: objective " << format_number(result.baseline.objective) << ", mean |I_r| "
-       << format_number(result.baseline.metrics.at("ir_magnitude_mean")) << " x 1e-7 kg m, peak amplitude "
-       << format_number(result.baseline.metrics.at("amplitude_max_mm")) << " mm, %MI "
-       << format_number(result.baseline.metrics.at("pct_mi")) << " (" << f.base.runs << " runs)";
+    os << "baseline: objective " << g4(result.baseline.objective) << ", mean |I_r| "
+       << g4(result.baseline.metrics.at("ir_magnitude_mean")) << " x 1e-7 kg m, peak amplitude "
+       << g4(result.baseline.metrics.at("amplitude_max_mm")) << " mm, %MI "
+       << g4(result.baseline.metrics.at("pct_mi")) << " (" << f.base.runs << " runs)";
     c.log(os.str());
   }
 

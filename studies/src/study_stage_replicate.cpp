@@ -1,6 +1,7 @@
 // Stage kind `replicate`: the best design of every choice on fresh samples (one per seed: other
-// initial angles and other draws of the envelope). A design is recommended only if it meets the
-// constraints on every replication; among those, the lowest mean objective wins. The in-sample
+// initial angles and other draws of the envelope; constraints relative to the baseline hold against
+// the baseline on the same sample). A design is recommended only if it meets the constraints on
+// every replication; among those, the lowest mean objective wins. The in-sample
 // optimum is biased low (the optimiser chose it on that sample): this is the honest comparison.
 #include <cmath>
 #include <limits>
@@ -20,7 +21,7 @@ void run_replicate_stage(StudyContext& c, const StageSpec& stage) {
     bool all = true;
     for (std::uint64_t seed : stage.seeds) {
       if (c.stop()) return;
-      const opt::Evaluation e = c.evaluate_profile(c.fresh(ch.balls, seed, stage.runs), d.profile);
+      const opt::Evaluation e = c.evaluate_profile(c.fresh(ch.balls, seed, stage.runs).settings, d.profile);
       d.replications.push_back(e);
       sum += e.objective;
       all = all && feasible(e);
@@ -29,7 +30,7 @@ void run_replicate_stage(StudyContext& c, const StageSpec& stage) {
     d.replicated_objective = sum / static_cast<double>(d.replications.size());
     std::ostringstream os;
     os << "stage " << stage.name << " (" << ch.balls << " balls): " << d.label << " on " << stage.seeds.size()
-       << " fresh samples: mean objective " << format_number(d.replicated_objective)
+       << " fresh samples: mean objective " << format_number(std::round(d.replicated_objective * 1000) / 1000)
        << (all ? ", feasible on every one" : ", NOT feasible on every one");
     c.log(os.str());
   }

@@ -49,14 +49,11 @@ void run_validate_stage(StudyContext& c, const StageSpec& stage) {
   std::vector<double> ratio;
   for (std::uint64_t seed : stage.seeds) {
     if (c.stop()) return;
-    const problems::StartupProfileSettings ds = c.fresh(d.balls, seed, stage.runs);
-    problems::StartupProfileSettings bs = c.baseline_settings();
-    bs.study.seed = bs.study.design.seed = seed;
-    bs.study.runs = ds.study.runs;
-    v.runs = ds.study.runs;
-    const opt::Evaluation de = c.evaluate_profile(ds, d.profile);
+    const StudyContext::Fresh fr = c.fresh(d.balls, seed, stage.runs);
+    v.runs = fr.settings.study.runs;
+    const opt::Evaluation& be = fr.baseline;
     if (c.stop()) return;
-    const opt::Evaluation be = c.evaluate_profile(bs, c.file.base.setup.profile);
+    const opt::Evaluation de = c.evaluate_profile(fr.settings, d.profile);
     for (const char* m : kMetrics) {
       dv[m].push_back(de.metrics.count(m) ? de.metrics.at(m) : NAN);
       bv[m].push_back(be.metrics.count(m) ? be.metrics.at(m) : NAN);
@@ -89,10 +86,11 @@ void run_validate_stage(StudyContext& c, const StageSpec& stage) {
           s.study.uncertain.friction = FrictionUncertainty{FrictionSampling::Fixed, mu, {}, mu, mu};
           s.study.uncertain.imbalance_mass = ImbalanceMassUncertainty{ImbalanceMassSampling::RelativeRange, imb, imb};
           s.objective.robust_friction_mu.clear();
+          if (c.options.threads) s.threads = *c.options.threads;
           return s;
         };
-        const opt::Evaluation de = c.evaluate_profile(at_point(c.fresh(d.balls, seed, runs)), d.profile);
-        const opt::Evaluation be = c.evaluate_profile(at_point(c.baseline_settings()), c.file.base.setup.profile);
+        const opt::Evaluation be = c.evaluate_profile(at_point(c.baseline_sample(seed, runs)), c.file.base.setup.profile);
+        const opt::Evaluation de = c.evaluate_profile(at_point(settings_of_choice(c.file, d.balls, be.metrics)), d.profile);
         row.push_back(de.ok && be.ok ? de.metrics.at("ir_magnitude_mean") / be.metrics.at("ir_magnitude_mean") : NAN);
       }
       v.map_ratio.push_back(row);

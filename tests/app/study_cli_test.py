@@ -42,12 +42,12 @@ def run(args, expect=0):
 def tiny_study(tmp):
     """The quick study shrunk to seconds: 4 runs, 3 + 3 evaluations, one replication, a 1 x 2 map."""
     text = open(QUICK).read()
-    text = text.replace("runs: 16, seed: 21", "runs: 4, seed: 21")
-    text = text.replace("{algorithm: direct_l, max_evaluations: 10}", "{algorithm: direct_l, max_evaluations: 3}")
-    text = text.replace("max_evaluations: 10, initial_step: 0.1", "max_evaluations: 3, initial_step: 0.1")
-    text = text.replace("seeds: [101, 102], runs: 16", "seeds: [101], runs: 4")
-    text = text.replace("seeds: [9001, 9002, 9003]\n    runs: 32", "seeds: [9001, 9002]\n    runs: 4")
-    text = text.replace("map: {friction_mu: [0.02, 0.04], imbalance_relative: [-0.2, 0.2], runs: 16}",
+    text = text.replace("runs: 64, seed: 21", "runs: 4, seed: 21")
+    text = text.replace("{algorithm: direct_l, max_evaluations: 30}", "{algorithm: direct_l, max_evaluations: 3}")
+    text = text.replace("max_evaluations: 30, initial_step: 0.1", "max_evaluations: 3, initial_step: 0.1")
+    text = text.replace("seeds: [101, 102, 103], runs: 64", "seeds: [101], runs: 4")
+    text = text.replace("seeds: [9001, 9002, 9003, 9004]\n    runs: 256", "seeds: [9001, 9002]\n    runs: 4")
+    text = text.replace("map: {friction_mu: [0.02, 0.03, 0.04], imbalance_relative: [-0.2, 0, 0.2], runs: 64}",
                         "map: {friction_mu: [0.03], imbalance_relative: [-0.2, 0.2], runs: 4}")
     assert text.count("runs: 4") >= 4, text
     path = os.path.join(tmp, "tiny.yaml")

@@ -54,11 +54,11 @@ TEST(StudyFile, QuickStudyReads) {
   ASSERT_EQ(f.stages.size(), 4u);
   EXPECT_EQ(f.stages[0].kind, StageKind::Global);
   EXPECT_EQ(f.stages[3].kind, StageKind::Validate);
-  EXPECT_EQ(f.stages[3].seeds.size(), 3u);
+  EXPECT_EQ(f.stages[3].seeds.size(), 4u);
   EXPECT_TRUE(f.frequencies_natural);
   ASSERT_EQ(f.ball_counts.size(), 1u);
   EXPECT_EQ(f.ball_counts[0], 2u);
-  EXPECT_EQ(f.base.runs, 16u);
+  EXPECT_EQ(f.base.runs, 64u);
   EXPECT_EQ(f.base.uncertain.friction.sampling, FrictionSampling::Range);
 }
 
@@ -119,17 +119,17 @@ TEST(StudyFile, ResonanceOutOfReachIsSaid) {
 
 TEST(StudyFile, BadInputNamesKeyValueAndRule) {
   const std::string q = quick_text();
-  std::string e = error_of(replace(q, "runs: 16, seed: 21", "runs: 16, seed: 21, colour: red"));
+  std::string e = error_of(replace(q, "runs: 64, seed: 21", "runs: 64, seed: 21, colour: red"));
   EXPECT_NE(e.find("sampling.colour"), std::string::npos) << e;
-  e = error_of(replace(q, "{kind: global, optimizer: {algorithm: direct_l, max_evaluations: 10}}",
-                       "{kind: global, optimizer: {algorithm: direct_l, max_evaluations: 10}, seeds: [1]}"));
+  e = error_of(replace(q, "{kind: global, optimizer: {algorithm: direct_l, max_evaluations: 30}}",
+                       "{kind: global, optimizer: {algorithm: direct_l, max_evaluations: 30}, seeds: [1]}"));
   EXPECT_NE(e.find("stages[0].seeds"), std::string::npos) << e;
   EXPECT_NE(e.find("only used by replicate and validate"), std::string::npos) << e;
   e = error_of(replace(q, "kind: validate", "kind: check"));
   EXPECT_NE(e.find("stages[3].kind = check"), std::string::npos) << e;
-  e = error_of(replace(q, "  - {kind: replicate, seeds: [101, 102], runs: 16}\n", "") + "");
+  e = error_of(replace(q, "  - {kind: replicate, seeds: [101, 102, 103], runs: 64}\n", "") + "");
   EXPECT_EQ(e, "");
-  e = error_of(replace(q, "- {kind: global, optimizer: {algorithm: direct_l, max_evaluations: 10}}",
+  e = error_of(replace(q, "- {kind: global, optimizer: {algorithm: direct_l, max_evaluations: 30}}",
                        "- {kind: replicate, seeds: [1]}"));
   EXPECT_NE(e.find("stages[0].kind = replicate"), std::string::npos) << e;
   e = error_of(replace(q, "amplitude_vs_baseline: 1.0", "amplitude_vs_baseline: 1.0\n  max_amplitude_mm: 0.5"));
