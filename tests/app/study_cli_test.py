@@ -102,9 +102,10 @@ def mode_tiny():
         check_outputs(out1, s1)
         if s1["baseline"]["metrics"]["runs"] != 4:
             fail("baseline runs")
-        # every optimiser stage: 3 evaluations at most, none from an archive on the first run
-        for t in s1["traces"]:
-            if not (1 <= t["evaluations"] <= 3) or t["archive_hits"] != 0:
+        # every optimiser stage: 3 evaluations at most; on the first run only a stage's starting point
+        # (the previous stage's best) comes from the archive
+        for i, t in enumerate(s1["traces"]):
+            if not (1 <= t["evaluations"] <= 3) or t["archive_hits"] != (0 if i == 0 else 1):
                 fail(f"trace {t}")
         # the design file runs with abuopt montecarlo
         design = os.path.join(out1, s1["designs"][0]["file"])
@@ -181,10 +182,11 @@ def mode_browser():
                  "--enable-logging=stderr", "--v=0"]
         page = "file://" + os.path.abspath(os.path.join(out, "report.html"))
         p = subprocess.run([exe] + flags + ["--dump-dom", page], capture_output=True, text=True, timeout=120)
-        console = [l for l in p.stderr.splitlines() if "CONSOLE" in l]
-        errors = [l for l in console if re.search(r"error|uncaught", l, re.I)]
-        if errors:
-            fail("console errors:\n" + "\n".join(errors))
+        # Chromium logs every console message as "INFO:CONSOLE" whatever its level (console.error
+        # too), and the report has no script: any console line is a failure
+        console = [l for l in p.stderr.splitlines() if ":CONSOLE" in l]
+        if console:
+            fail("console messages:\n" + "\n".join(console))
         if "Recommended design" not in p.stdout and "No design is recommended" not in p.stdout:
             fail("Chromium's DOM lacks the answer:\n" + p.stdout[:2000])
         # 2. a copy with a check script: every figure laid out with a non-zero size
