@@ -18,7 +18,7 @@ struct ChoiceContext {
   std::unique_ptr<opt::EvaluationArchive> archive;
   std::unique_ptr<opt::ArchivedProblem> archived;
   std::vector<double> x;                 // the best design so far (empty: the family's x0)
-  std::optional<std::size_t> last_design;  // index into StudyResult::designs
+  std::optional<std::size_t> last_design;  // the best design so far: index into StudyResult::designs
   std::vector<double> least_violation;   // per constraint: the smallest g_i seen (for "cannot be met")
 };
 

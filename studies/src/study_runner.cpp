@@ -175,8 +175,19 @@ void run_optimiser_stage(StudyContext& c, const StageSpec& stage, bool from_best
     d.in_sample = ch.archived->evaluate(best_x);  // an archive hit
     d.robust_feasible = feasible(d.in_sample);
     d.replicated_objective = d.in_sample.objective;
-    ch.x = best_x;
-    ch.last_design = c.result.designs.size();
+    // the next stage starts from the best design so far (a stage that found nothing better keeps it)
+    const auto better = [](const StudyDesign& a, const StudyDesign& b) {
+      const bool fa = feasible(a.in_sample), fb = feasible(b.in_sample);
+      if (fa != fb) return fa;
+      if (fa) return a.in_sample.objective < b.in_sample.objective;
+      return opt::max_constraint_violation(a.in_sample) < opt::max_constraint_violation(b.in_sample);
+    };
+    if (!ch.last_design || better(d, c.result.designs[*ch.last_design])) {
+      ch.x = best_x;
+      ch.last_design = c.result.designs.size();
+    } else {
+      c.log("  not better than " + c.result.designs[*ch.last_design].label + ": the next stage starts from that one");
+    }
     c.result.designs.push_back(d);
     std::ostringstream done;
     done << "  " << tr.reason << " after " << r.evaluations << " evaluations (" << r.archive_hits

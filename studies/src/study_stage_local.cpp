@@ -1,5 +1,5 @@
 // Stage kind `local`: a polish (COBYLA, BOBYQA, SLSQP, ...) on every choice, starting from the best
-// design of the stage before it (the family's starting point when it is the first stage).
+// design so far (the family's starting point when it is the first stage).
 #include "study_context.hpp"
 
 namespace abuopt::studies::detail {

@@ -12,7 +12,7 @@
 // `constraints` (absolute, or relative to the baseline), the `stages` and one `budget`.
 // Stage kinds (one file each, studies/src/study_stage_*.cpp):
 //   global     an optimiser of the registry from the family's starting point
-//   local      an optimiser from the previous stage's best (a polish)
+//   local      an optimiser from the best design so far (a polish)
 //   replicate  the best design of every choice on fresh samples (other seeds): the recommended
 //              design is the best mean objective among those feasible on every replication
 //   validate   the recommended design and the baseline on fresh, larger samples (intervals over
