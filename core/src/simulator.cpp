@@ -144,6 +144,8 @@ class Run {
   static AbuParameters with_overrides(AbuParameters p, const RunOverrides& ov) {
     if (ov.friction_mu) p.friction_mu = *ov.friction_mu;
     if (ov.imbalance_mass_kg) p.imbalance_mass_kg = *ov.imbalance_mass_kg;
+    if (ov.stiffness_N_per_m) p.stiffness_N_per_m = *ov.stiffness_N_per_m;
+    if (ov.ball_restitution) p.ball_restitution = *ov.ball_restitution;
     return p;
   }
   void choose_initial_modes();
@@ -457,6 +459,11 @@ RunOutcome Simulator::run(const std::vector<double>& beta0, const RunOverrides& 
   if (beta0.size() != setup_.abu.balls.size())  // API misuse: the caller sizes beta0 from ball_count()
     throw std::invalid_argument("Simulator::run: the ABU has " + std::to_string(setup_.abu.balls.size()) +
                                 " balls, but " + std::to_string(beta0.size()) + " initial angles were given");
+  if ((ov.stiffness_N_per_m && !(*ov.stiffness_N_per_m > 0 && std::isfinite(*ov.stiffness_N_per_m))) ||
+      (ov.imbalance_mass_kg && !(*ov.imbalance_mass_kg > 0 && std::isfinite(*ov.imbalance_mass_kg))) ||
+      (ov.ball_restitution && !(*ov.ball_restitution >= 0 && *ov.ball_restitution <= 1)))
+    throw std::invalid_argument("Simulator::run: an override is out of range (stiffness and imbalance mass > 0, "
+                                "restitution in [0, 1])");
   Run run(setup_, end_time_s(), beta0, ov, trajectory, stuck_table_.get());
   RunOutcome out = run.execute();
   out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
