@@ -68,9 +68,9 @@ StageSpec read_stage(YamlReader& r) {
         throw ConfigError(r.key_path("map"), "<given>", "is only used by the validate stage");
       YamlReader m = r.child("map");
       s.map_friction_mu = m.get_double_list("friction_mu", Rule::in_range(0.0, 0.999));
-      s.map_imbalance_relative = m.get_double_list("imbalance_relative", Rule::in_range(-0.99, 10.0));
+      s.map_imbalance_factor = m.get_double_list("imbalance_mass_factor", Rule::in_range(0.01, 10.0));
       s.map_runs = static_cast<std::size_t>(m.get_int_or("runs", 0, Rule::in_range(0, 1e7)));
-      if (s.map_friction_mu.empty() || s.map_imbalance_relative.empty())
+      if (s.map_friction_mu.empty() || s.map_imbalance_factor.empty())
         throw ConfigError(m.key_path("friction_mu"), "[]", "the map needs at least one friction and one imbalance value");
       m.finish();
     }
@@ -132,13 +132,10 @@ StudyFile read_study_file(const std::string& path) {
     describe_montecarlo_fields(a, f.base, f.threads);
     s.finish();
   }
-  {  // the envelope: uncertain parameters drawn per run (objective and constraints hold over it)
-    YamlReader e = root.child("envelope");
-    YamlReadArchive a(e);
-    describe_fields(a, f.base.uncertain);
-    e.finish();
-    validate(f.base.uncertain, "envelope");
-  }
+  // the envelope: uncertain parameters drawn per run (core/envelope.hpp; objective and constraints
+  // hold over it)
+  f.base.uncertain.envelope = read_envelope(root);
+
   {  // the profile family
     if (!root.has("family"))
       throw ConfigError("family", "<missing>", "is required (family: {segments: [...]} with free {min, max} values)");
@@ -172,6 +169,9 @@ StudyFile read_study_file(const std::string& path) {
   {
     YamlReader o = root.child("objective");
     read_fields(o, f.objective);
+    if (!f.objective.robust_friction_mu.empty() && f.base.uncertain.envelope.friction_mu.given())
+      throw ConfigError("objective.robust.friction_mu", format_number(f.objective.robust_friction_mu.front()),
+                        "cannot be combined with envelope.friction_mu (give the friction values in one place)");
   }
   {
     YamlReader c = root.child("constraints");

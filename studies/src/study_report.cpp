@@ -229,7 +229,7 @@ nlohmann::json summary(const StudyFile& f, const StudyResult& r) {
     j["validation"] = {{"runs", v.runs}, {"seeds", v.seeds}, {"design", dv}, {"baseline", bv},
                        {"ratio_mean_abs_ir", interval_json(v.ratio_mean_ir)}};
     if (!v.map_ratio.empty())
-      j["validation"]["map"] = {{"friction_mu", v.map_mu}, {"imbalance_relative", v.map_imbalance},
+      j["validation"]["map"] = {{"friction_mu", v.map_mu}, {"imbalance_mass_factor", v.map_imbalance},
                                 {"runs", v.map_runs}, {"ratio_mean_abs_ir", v.map_ratio}};
   }
   j["traces"] = nlohmann::json::array();

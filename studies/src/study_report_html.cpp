@@ -121,7 +121,7 @@ std::string study_html(const StudyFile& f, const StudyResult& r) {
     const ValidationResult& v = r.validation;
     h << "<h2>Ratio to the baseline over the envelope</h2>\n<figure>"
       << svg_heatmap("mean |I_r| of the recommended design / the baseline's", "friction mu",
-                     "imbalance change", v.map_mu, v.map_imbalance, v.map_ratio, 1.0, 720,
+                     "imbalance mass factor", v.map_mu, v.map_imbalance, v.map_ratio, 1.0, 720,
                      std::max(220, 80 + 50 * static_cast<int>(v.map_imbalance.size())))
       << "<figcaption>Each cell: a Monte Carlo of " << v.map_runs
       << " runs with the friction and the imbalance fixed at that point (same initial angles for both profiles). "

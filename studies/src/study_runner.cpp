@@ -226,7 +226,7 @@ StudyResult run_study(const StudyFile& f, const StudyRunOptions& o) {
     else if (s.kind == StageKind::Replicate)
       other += static_cast<long>(s.seeds.size() * (f.ball_counts.size() + 1));
     else
-      other += static_cast<long>(2 * s.seeds.size() + 2 * s.map_friction_mu.size() * s.map_imbalance_relative.size());
+      other += static_cast<long>(2 * s.seeds.size() + 2 * s.map_friction_mu.size() * s.map_imbalance_factor.size());
   }
   c.total = std::min(optimiser, f.max_evaluations) + other;
 
@@ -294,7 +294,7 @@ StudyResult run_study(const StudyFile& f, const StudyRunOptions& o) {
         if (ch.least_violation[i] > kTolerance) {
           std::ostringstream os;
           os << "constraint " << result.constraint_names[i] << " cannot be met with " << ch.balls
-             << " balls: its least value over every evaluation is g = " << format_number(ch.least_violation[i])
+             << " balls: its least value over every evaluation is g = " << g4(ch.least_violation[i])
              << " (the bound exceeded by " << format_number(std::round(ch.least_violation[i] * 1000) / 10) << " %)";
           result.notes.push_back(os.str());
           c.log("note: " + os.str());

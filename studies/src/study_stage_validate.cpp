@@ -1,6 +1,7 @@
 // Stage kind `validate`: the recommended design and the baseline on fresh, larger samples (one per
 // seed), each metric as a mean with a 95 % t-interval over the seeds; and, with a map, the ratio
-// of their mean |I_r| at fixed points (friction mu, imbalance change) of the envelope.
+// of their mean |I_r| at fixed points (friction mu, imbalance mass factor) of the envelope (the
+// envelope's other parameters, e.g. stiffness, still drawn per run).
 #include <cmath>
 #include <sstream>
 
@@ -74,17 +75,17 @@ void run_validate_stage(StudyContext& c, const StageSpec& stage) {
     const std::size_t runs = stage.map_runs ? stage.map_runs : v.runs;
     const std::uint64_t seed = stage.seeds.front();
     v.map_mu = stage.map_friction_mu;
-    v.map_imbalance = stage.map_imbalance_relative;
+    v.map_imbalance = stage.map_imbalance_factor;
     v.map_runs = runs;
-    for (double imb : stage.map_imbalance_relative) {
+    for (double imb : stage.map_imbalance_factor) {
       std::vector<double> row;
       for (double mu : stage.map_friction_mu) {
         if (c.stop()) return;
         const auto at_point = [&](problems::StartupProfileSettings s) {
           s.study.seed = s.study.design.seed = seed;
           s.study.runs = runs;
-          s.study.uncertain.friction = FrictionUncertainty{FrictionSampling::Fixed, mu, {}, mu, mu};
-          s.study.uncertain.imbalance_mass = ImbalanceMassUncertainty{ImbalanceMassSampling::RelativeRange, imb, imb};
+          s.study.uncertain.envelope.friction_mu = ParameterDistribution::fixed(mu);
+          s.study.uncertain.envelope.imbalance_mass_factor = ParameterDistribution::fixed(imb);
           s.objective.robust_friction_mu.clear();
           if (c.options.threads) s.threads = *c.options.threads;
           return s;

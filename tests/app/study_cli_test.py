@@ -47,8 +47,8 @@ def tiny_study(tmp):
     text = text.replace("max_evaluations: 30, initial_step: 0.1", "max_evaluations: 3, initial_step: 0.1")
     text = text.replace("seeds: [101, 102, 103], runs: 64", "seeds: [101], runs: 4")
     text = text.replace("seeds: [9001, 9002, 9003, 9004]\n    runs: 256", "seeds: [9001, 9002]\n    runs: 4")
-    text = text.replace("map: {friction_mu: [0.02, 0.03, 0.04], imbalance_relative: [-0.2, 0, 0.2], runs: 64}",
-                        "map: {friction_mu: [0.03], imbalance_relative: [-0.2, 0.2], runs: 4}")
+    text = text.replace("map: {friction_mu: [0.02, 0.03, 0.04], imbalance_mass_factor: [0.8, 1, 1.2], runs: 64}",
+                        "map: {friction_mu: [0.03], imbalance_mass_factor: [0.8, 1.2], runs: 4}")
     assert text.count("runs: 4") >= 4, text
     path = os.path.join(tmp, "tiny.yaml")
     with open(path, "w") as f:

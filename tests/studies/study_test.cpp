@@ -59,7 +59,8 @@ TEST(StudyFile, QuickStudyReads) {
   ASSERT_EQ(f.ball_counts.size(), 1u);
   EXPECT_EQ(f.ball_counts[0], 2u);
   EXPECT_EQ(f.base.runs, 64u);
-  EXPECT_EQ(f.base.uncertain.friction.sampling, FrictionSampling::Range);
+  EXPECT_EQ(f.base.uncertain.envelope.friction_mu.kind, DistributionKind::Uniform);
+  EXPECT_EQ(f.base.uncertain.envelope.imbalance_mass_factor.hi, 1.2);
 }
 
 TEST(StudyFile, FrequencyBoundsFollowTheNaturalFrequency) {
@@ -136,8 +137,11 @@ TEST(StudyFile, BadInputNamesKeyValueAndRule) {
   EXPECT_NE(e.find("constraints.amplitude_vs_baseline"), std::string::npos) << e;
   e = error_of(replace(q, "algorithm: cobyla", "algorithm: nelder"));
   EXPECT_NE(e.find("unknown algorithm"), std::string::npos) << e;
-  e = error_of(replace(q, "friction: {range: [0.02, 0.04]}", "friction: {range: [0.04, 0.02]}"));
-  EXPECT_NE(e.find("envelope.friction"), std::string::npos) << e;
+  e = error_of(replace(q, "friction_mu: {uniform: [0.02, 0.04]}", "friction_mu: {uniform: [0.04, 0.02]}"));
+  EXPECT_NE(e.find("envelope.friction_mu"), std::string::npos) << e;
+  e = error_of(replace(q, "runs: 64, seed: 21}", "runs: 64, seed: 21, friction: {range: [0.02, 0.04]}}"));
+  EXPECT_NE(e.find("sampling.friction"), std::string::npos) << e;
+  EXPECT_NE(e.find("envelope"), std::string::npos) << e;
   e = error_of(replace(q, "{min: 0.97, max: 1.1, x0: 1.02}", "{min: 0.97, max: 1.1, x0: 1.5}"));
   EXPECT_NE(e.find("family.segments[1].end_frequency_hz"), std::string::npos) << e;
 }

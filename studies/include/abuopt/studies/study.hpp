@@ -48,7 +48,7 @@ struct StageSpec {
   std::size_t runs = 0;             // replicate, validate: runs per sample (0: the sampling's runs)
   // validate: the ratio map over the envelope (empty: no map)
   std::vector<double> map_friction_mu;
-  std::vector<double> map_imbalance_relative;
+  std::vector<double> map_imbalance_factor;  // x abu.imbalance_mass_kg
   std::size_t map_runs = 0;         // runs per map point (0: the stage's runs)
 };
 
@@ -123,7 +123,7 @@ struct ValidationResult {
   std::map<std::string, Interval> design, baseline;  // per metric
   Interval ratio_mean_ir;                            // design / baseline mean |I_r|, per seed
   std::vector<double> map_mu, map_imbalance;
-  std::vector<std::vector<double>> map_ratio;        // [imbalance][mu]: design / baseline mean |I_r|
+  std::vector<std::vector<double>> map_ratio;        // [imbalance factor][mu]: design / baseline mean |I_r|
   std::size_t map_runs = 0;
 };
 
