@@ -30,6 +30,7 @@ struct StudyContext {
   long used = 0;     // optimiser evaluations so far (budget)
   long done = 0;     // progress units done
   long total = 0;    // progress units planned
+  bool interrupted = false;  // an optimiser stopped on SIGINT (its own handler ran, not the caller's)
   std::vector<ChoiceContext> choices;
 
   void log(const std::string& line) const;

@@ -45,7 +45,7 @@ bool feasible(const opt::Evaluation& e) { return opt::is_feasible(e, kTolerance)
 void StudyContext::log(const std::string& line) const {
   if (options.log) options.log(line);
 }
-bool StudyContext::stop() const { return options.stop_requested && options.stop_requested(); }
+bool StudyContext::stop() const { return interrupted || (options.stop_requested && options.stop_requested()); }
 void StudyContext::tick(long n) {
   done += n;
   if (options.progress) options.progress(done, std::max(done, total));
@@ -156,6 +156,7 @@ void run_optimiser_stage(StudyContext& c, const StageSpec& stage, bool from_best
     c.log(head.str());
     const opt::OptimizationResult r = opt::minimize(p, o, x0, cb);
     c.used += r.evaluations;
+    if (r.reason == opt::TerminationReason::Interrupted) c.interrupted = true;
     tr.algorithm = r.algorithm;
     tr.reason = to_string(r.reason);
     tr.evaluations = r.evaluations;

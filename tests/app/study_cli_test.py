@@ -9,8 +9,8 @@
                                     error, every inline figure rendered with a non-zero size
                                     (exit 77 = skipped when chromium is not installed)
   study_cli_test.py ABUOPT quick    configs/studies/quick.yaml end to end (<= 2 min on 2 cores), killed
-                                    with SIGKILL part way and resumed: the same summary as a run that
-                                    was never interrupted
+                                    with SIGKILL part way and resumed, and interrupted with SIGINT and
+                                    resumed: the same summary as a run that was never interrupted
 """
 import json
 import os
@@ -236,6 +236,22 @@ def mode_quick():
         if comparable(a) != comparable(b):
             fail("the resumed run's results differ from the straight run's")
         print(f"ok: killed after {wall / 3:.0f} s, resumed with {b['archive_hits']} evaluations from the archive, same results")
+        # Ctrl-C (SIGINT) half way: exit 130 with the partial report, then the rerun ends as the straight run
+        ctrl_c = os.path.join(tmp, "ctrl_c")
+        p = subprocess.Popen([EXE, "study", QUICK, "--out", ctrl_c], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                             text=True)
+        time.sleep(wall / 2)
+        p.send_signal(signal.SIGINT)
+        out, _ = p.communicate(timeout=300)
+        if p.returncode != 130 or "rerun the same command to resume" not in out:
+            fail(f"after SIGINT: exit {p.returncode}\n{out}")
+        if not os.path.exists(os.path.join(ctrl_c, "report.html")):
+            fail("no partial report after SIGINT")
+        run(["study", QUICK, "--out", ctrl_c])
+        c = json.load(open(os.path.join(ctrl_c, "summary.json")))
+        if comparable(a) != comparable(c):
+            fail("the run resumed after Ctrl-C differs from the straight run")
+        print("ok: Ctrl-C gives exit 130 and a partial report; the rerun ends with the same results")
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 
