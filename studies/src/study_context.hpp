@@ -58,6 +58,9 @@ void run_global_stage(StudyContext& c, const StageSpec& stage);
 void run_local_stage(StudyContext& c, const StageSpec& stage);
 void run_replicate_stage(StudyContext& c, const StageSpec& stage);
 void run_validate_stage(StudyContext& c, const StageSpec& stage);
+// The final positions of the recommended design and the baseline over the equilibrium set (two
+// balls; studies/src/study_final_positions.cpp).
+void final_positions(StudyContext& c, const StudyDesign& d, std::uint64_t seed, std::size_t runs);
 // The recommended design without a replicate stage: the best in-sample feasible final design.
 void recommend_in_sample(StudyContext& c);
 

@@ -128,6 +128,25 @@ std::string study_html(const StudyFile& f, const StudyResult& r) {
       << "Below 1 (blue): the design is better than the baseline there.</figcaption></figure>\n";
   }
 
+  // ---- final positions over the equilibrium set ----
+  if (!r.validation.final_design.empty()) {
+    const ValidationResult& v = r.validation;
+    std::vector<SvgPointGroup> groups = {
+        {"baseline (" + std::to_string(v.final_baseline.size()) + " runs)", "#555555", v.final_baseline, true},
+        {"recommended (" + std::to_string(v.final_design.size()) + " runs)", "#d62728", v.final_design, false}};
+    h << "<h2>Final ball positions over the equilibrium set</h2>\n<figure>"
+      << svg_points_over_set("Final angles of the two balls", "beta_1 [deg]", "beta_2 [deg]", v.eq_n, v.eq_in_set,
+                             "equilibrium set at " + sig3(v.eq_frequency_hz) + " Hz, mu " + sig3(v.eq_mu) + " (" +
+                                 sig3(100.0 * static_cast<double>(std::count(v.eq_in_set.begin(), v.eq_in_set.end(), 1)) /
+                                      static_cast<double>(std::max<std::size_t>(1, v.eq_in_set.size()))) +
+                                 " % of the torus)",
+                             groups)
+      << "<figcaption>Where the balls stop, on the first fresh sample of the validation (the envelope's draws per run). "
+         "Shaded: the configurations in which both balls can stay stuck at the last frequency with the nominal "
+         "friction (report section 4.2); the balancing positions lie where the residual imbalance vanishes."
+         "</figcaption></figure>\n";
+  }
+
   // ---- convergence ----
   h << "<h2>Convergence of every stage</h2>\n";
   std::vector<SvgSeries> conv;

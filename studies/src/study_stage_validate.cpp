@@ -99,6 +99,7 @@ void run_validate_stage(StudyContext& c, const StageSpec& stage) {
     c.log("stage " + stage.name + ": ratio map over " + std::to_string(v.map_mu.size() * v.map_imbalance.size()) +
           " envelope points (" + std::to_string(runs) + " runs each)");
   }
+  if (!c.stop()) final_positions(c, d, stage.seeds.front(), std::min<std::size_t>(v.runs, 256));
   v.done = true;
 }
 

@@ -199,4 +199,50 @@ std::string svg_heatmap(const std::string& title, const std::string& x_label, co
   return o.str();
 }
 
+std::string svg_points_over_set(const std::string& title, const std::string& x_label, const std::string& y_label,
+                                std::size_t n, const std::vector<char>& in_set, const std::string& set_name,
+                                const std::vector<SvgPointGroup>& groups, int size) {
+  const int width = size + 300, height = size;
+  const double L = 70, T = 30, B = height - 50.0, R = L + (B - T);
+  const auto X = [&](double deg) { return L + deg / 360.0 * (R - L); };
+  const auto Y = [&](double deg) { return B - deg / 360.0 * (B - T); };
+  std::ostringstream o;
+  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
+    << "\" viewBox=\"0 0 " << width << " " << height << "\" role=\"img\" aria-label=\"" << xml_escape(title)
+    << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
+    << "<text x=\"" << (L + R) / 2 << "\" y=\"18\" text-anchor=\"middle\" font-size=\"14\">" << xml_escape(title)
+    << "</text>\n";
+  const double cell = (R - L) / static_cast<double>(std::max<std::size_t>(1, n));
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < n; ++j)
+      if (i * n + j < in_set.size() && in_set[i * n + j])
+        o << "<rect x=\"" << px(L + i * cell) << "\" y=\"" << px(B - (j + 1) * cell) << "\" width=\"" << px(cell + 0.3)
+          << "\" height=\"" << px(cell + 0.3) << "\" fill=\"#cfe3cf\"/>";
+  o << "\n<rect x=\"" << L << "\" y=\"" << T << "\" width=\"" << R - L << "\" height=\"" << B - T
+    << "\" fill=\"none\" stroke=\"#444\"/>\n";
+  for (double t = 0; t <= 360; t += 90)
+    o << "<text x=\"" << px(X(t)) << "\" y=\"" << B + 15 << "\" text-anchor=\"middle\">" << num(t)
+      << "</text><text x=\"" << L - 5 << "\" y=\"" << px(Y(t) + 4) << "\" text-anchor=\"end\">" << num(t) << "</text>\n";
+  o << "<text x=\"" << (L + R) / 2 << "\" y=\"" << B + 34 << "\" text-anchor=\"middle\">" << xml_escape(x_label)
+    << "</text>\n<text transform=\"translate(16," << (T + B) / 2 << ") rotate(-90)\" text-anchor=\"middle\">"
+    << xml_escape(y_label) << "</text>\n";
+  for (const auto& g : groups)
+    for (const auto& [x, y] : g.points)
+      o << "<circle cx=\"" << px(X(x)) << "\" cy=\"" << px(Y(y)) << "\" r=\"3\" "
+        << (g.hollow ? "fill=\"none\" stroke=\"" + g.color + "\"" : "fill=\"" + g.color + "\" fill-opacity=\"0.7\"")
+        << "/>";
+  // legend on the right
+  double ly = T + 10;
+  o << "\n<rect x=\"" << px(R + 15) << "\" y=\"" << px(ly - 9) << "\" width=\"12\" height=\"12\" fill=\"#cfe3cf\"/>"
+    << "<text x=\"" << px(R + 32) << "\" y=\"" << px(ly + 1) << "\">" << xml_escape(set_name) << "</text>\n";
+  for (const auto& g : groups) {
+    ly += 20;
+    o << "<circle cx=\"" << px(R + 21) << "\" cy=\"" << px(ly - 3) << "\" r=\"4\" "
+      << (g.hollow ? "fill=\"none\" stroke=\"" + g.color + "\"" : "fill=\"" + g.color + "\"") << "/><text x=\""
+      << px(R + 32) << "\" y=\"" << px(ly + 1) << "\">" << xml_escape(g.name) << "</text>\n";
+  }
+  o << "</svg>\n";
+  return o.str();
+}
+
 }  // namespace abuopt::studies::detail

@@ -24,6 +24,17 @@ std::string svg_heatmap(const std::string& title, const std::string& x_label, co
                         const std::vector<std::vector<double>>& values, double centre, int width = 720,
                         int height = 360);
 
+// Points (x, y) in [0, 360)^2 degrees over a set drawn as shaded cells (in_set: n x n, row-major,
+// index i * n + j for x cell i and y cell j); one colour per point group.
+struct SvgPointGroup {
+  std::string name, color;
+  std::vector<std::pair<double, double>> points;
+  bool hollow = false;
+};
+std::string svg_points_over_set(const std::string& title, const std::string& x_label, const std::string& y_label,
+                                std::size_t n, const std::vector<char>& in_set, const std::string& set_name,
+                                const std::vector<SvgPointGroup>& groups, int size = 520);
+
 // Text with &, <, >, " escaped for HTML and SVG.
 std::string xml_escape(const std::string& s);
 

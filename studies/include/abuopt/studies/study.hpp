@@ -125,6 +125,12 @@ struct ValidationResult {
   std::vector<double> map_mu, map_imbalance;
   std::vector<std::vector<double>> map_ratio;        // [imbalance factor][mu]: design / baseline mean |I_r|
   std::size_t map_runs = 0;
+  // Final ball angles [deg] of the recommended design and the baseline on the first fresh sample
+  // (two balls only), over the equilibrium set at the last frequency and the nominal friction.
+  std::vector<std::pair<double, double>> final_design, final_baseline;
+  std::size_t eq_n = 0;            // the set's grid: eq_n x eq_n over [0, 360)^2 deg
+  std::vector<char> eq_in_set;     // row-major: index i * eq_n + j = (beta_1 = i, beta_2 = j)
+  double eq_frequency_hz = 0, eq_mu = 0;
 };
 
 struct StudyResult {
