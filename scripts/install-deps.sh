@@ -24,6 +24,7 @@ packages=(
   python3                # scripts/startup_study.py, scripts/final_states_in_set.py (standard library only)
   python3-dev pybind11-dev python3-numpy  # the Python module abuopt (python/; skipped without them)
   python3-scipy python3-matplotlib        # examples/python (each says so and exits 0 without its package)
+  chromium               # headless browser: the test that opens abuopt study's report.html (tests/app/study_cli_test.py)
   python3-yaml           # scripts/stop_distribution.py reads configs (and its test)
 )
 

@@ -18,6 +18,7 @@ void register_optimize(CLI::App& app);
 void register_sweep(CLI::App& app);
 void register_pareto(CLI::App& app);
 void register_archive(CLI::App& app);
+void register_study(CLI::App& app);
 // Every subcommand above, in the order of `abuopt --help` (commands/register_all.cpp).
 void register_all(CLI::App& app);
 

@@ -14,6 +14,7 @@ void register_all(CLI::App& app) {
   register_sweep(app);
   register_pareto(app);
   register_archive(app);
+  register_study(app);
 }
 
 }  // namespace abuopt::app
