@@ -71,8 +71,13 @@ Simulator::Simulator(SimulationSetup setup) : setup_(std::move(setup)) {
   // table, so they are computed once here and shared by every run.
   const NondimParameters nd = NondimParameters::from(setup_.abu);
   if (o.stuck_integrator == StuckIntegrator::Exact && o.method == FrictionMethod::EventDriven &&
-      setup_.motor.kind == MotorKind::Ideal && StuckForcingTable::supports(nd))
-    stuck_table_ = StuckForcingTable::shared(setup_.profile, nd, end_time_s() * nd.omega_n);
+      setup_.motor.kind == MotorKind::Ideal && StuckForcingTable::supports(nd)) {
+    try {
+      stuck_table_ = StuckForcingTable::shared(setup_.profile, nd, end_time_s() * nd.omega_n);
+    } catch (const std::invalid_argument&) {
+      // a profile too long for a stored table (kMaxStoredIntervals): the Runge-Kutta path, in bounded memory
+    }
+  }
 }
 
 Simulator::~Simulator() = default;
