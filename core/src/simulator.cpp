@@ -38,6 +38,7 @@
 #include "abuopt/core/simulation_config.hpp"
 #include "integrator.hpp"
 #include "sim_run_state.hpp"
+#include "abuopt/common/stop.hpp"
 #include "stuck_propagator.hpp"
 
 namespace abuopt {
@@ -362,7 +363,12 @@ RunOutcome Run::execute() {
 
   const bool tail_enabled = event_driven_ && rs_.opt.closed_form_tail && !tracing;
   bool integ_stale = false;  // the exact propagator moved (t, y): the stepper restarts from there
+  unsigned long passes = 0;
   while (t < t_end_) {
+    // the stop request (SIGINT / SIGTERM, common/stop.hpp): a run can take seconds (chatter, a
+    // long end time), so it ends here too, not only between runs; the batch runner then reports
+    // the interruption and no outcome of this run is kept
+    if ((++passes & 255u) == 0 && stop_requested()) throw Interrupted("interrupted by " + stop_signal_name());
     Integrator::Result res = Integrator::Ok;
     if (stuck_ && rs_.frozen) {
       // every ball stuck: the exact propagator, to the next stop time (a breakpoint, the end, or
