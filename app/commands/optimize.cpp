@@ -387,7 +387,7 @@ int run_optimize(const OptimizeArgs& a) {
                                            {"out_of_sample", evaluation_json(rows[3].e, g_names)}}}};
     write_json();
   } else if (interrupted) {
-    log << "interrupted by " << stop_signal_name() << " after " << r.evaluations
+    std::cerr << "abuopt: interrupted by " << stop_signal_name() << " after " << r.evaluations
         << " evaluations: the best design so far is written, every evaluation is in the archive; rerun the same "
            "command to resume from the archive\n";
   }

@@ -162,7 +162,7 @@ int run_pareto_command(const ParetoArgs& a) {
   log << "wrote " << (out / "pareto.csv").string() << ", " << (out / "summary.json").string() << "\n" << plot << "\n";
   if (a.json) std::cout << j.dump(2) << "\n";
   if (r.interrupted) {
-    log << "interrupted by " << stop_signal_name() << ": kept the " << r.points.size()
+    std::cerr << "abuopt: interrupted by " << stop_signal_name() << ": kept the " << r.points.size()
         << " points above (pareto.csv, summary.json) and every evaluation in the archive; rerun the same command to "
            "resume\n";
     return stop_exit_status();

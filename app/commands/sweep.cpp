@@ -174,7 +174,7 @@ int run_sweep_command(const SweepArgs& a) {
   for (const auto& m : plots) log << m << "\n";
   if (a.json) std::cout << j.dump(2) << "\n";
   if (r.interrupted) {
-    log << "interrupted by " << stop_signal_name() << ": kept the " << r.points.size()
+    std::cerr << "abuopt: interrupted by " << stop_signal_name() << ": kept the " << r.points.size()
         << " points above (sweep.csv, summary.json, the archive); rerun the same command to evaluate the remaining "
            "points (stored ones come from the archive)\n";
     return stop_exit_status();
