@@ -21,6 +21,7 @@
 #include "abuopt/common/plot_style.hpp"
 #include "abuopt/common/text.hpp"
 #include "abuopt/common/progress.hpp"
+#include "abuopt/common/stop.hpp"
 #include "abuopt/common/provenance.hpp"
 #include "abuopt/core/monte_carlo.hpp"
 #include "abuopt/core/monte_carlo_stats.hpp"
@@ -195,7 +196,16 @@ int run_montecarlo(const MonteCarloArgs& a) {
       bar.set_total(total);
       bar.update(done);
     };
-  const MonteCarloResult result = run_monte_carlo(s, *runner, progress);
+  const StopScope stop_scope;  // SIGINT / SIGTERM stop the runs (abuopt/common/stop.hpp)
+  MonteCarloResult result;
+  try {
+    result = run_monte_carlo(s, *runner, progress);
+  } catch (const Interrupted& e) {
+    bar.finish();
+    throw Interrupted(std::string(e.what()) + "; nothing written (the statistics need every run" +
+                      (a.out.empty() ? "" : ", " + a.out + " is unchanged") +
+                      "); a rerun computes the same runs and the same result");
+  }
   bar.finish();
   const MonteCarloStats stats = compute_statistics(result);
 

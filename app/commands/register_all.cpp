@@ -15,6 +15,8 @@ void register_all(CLI::App& app) {
   register_pareto(app);
   register_archive(app);
   register_study(app);
+  // after every option is converted, before the command's callback runs
+  app.parse_complete_callback([&app] { check_option_values(app); });
 }
 
 }  // namespace abuopt::app

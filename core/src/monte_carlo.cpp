@@ -6,6 +6,7 @@
 #include <map>
 #include <numeric>
 
+#include "abuopt/common/stop.hpp"
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/core/ball_contact.hpp"
 
@@ -163,10 +164,16 @@ MonteCarloSample run_one(const MonteCarloStudy& s, std::size_t index, const Samp
 PreparedStudy prepare_study(const MonteCarloStudy& s) {
   validate(s);
   std::vector<std::vector<double>> points = generate_initial_conditions(study_design(s));
+  throw_if_stop_requested();  // a study of 10^6 runs takes seconds to prepare: the stop request ends it too
   PreparedStudy p;
   p.samples.resize(s.runs);
-  for (std::size_t i = 0; i < s.runs; ++i) p.samples[i] = make_sample(s, i, std::move(points[i]));
+  for (std::size_t i = 0; i < s.runs; ++i) {
+    if ((i & 4095) == 0) throw_if_stop_requested();
+    p.samples[i] = make_sample(s, i, std::move(points[i]));
+  }
+  throw_if_stop_requested();
   const std::vector<std::size_t> same = reuse_map(s, p.samples);
+  throw_if_stop_requested();
   for (std::size_t i = 0; i < s.runs; ++i) {
     p.samples[i].reused = same[i] != i;
     p.samples[i].reused_from = same[i];

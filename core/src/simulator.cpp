@@ -39,6 +39,7 @@
 #include "integrator.hpp"
 #include "sim_run_state.hpp"
 #include "run_forcing_table.hpp"
+#include "abuopt/common/stop.hpp"
 #include "stuck_propagator.hpp"
 
 namespace abuopt {
@@ -72,8 +73,13 @@ Simulator::Simulator(SimulationSetup setup) : setup_(std::move(setup)) {
   // table, so they are computed once here and shared by every run.
   const NondimParameters nd = NondimParameters::from(setup_.abu);
   if (o.stuck_integrator == StuckIntegrator::Exact && o.method == FrictionMethod::EventDriven &&
-      setup_.motor.kind == MotorKind::Ideal && StuckForcingTable::supports(nd))
-    stuck_table_ = StuckForcingTable::shared(setup_.profile, nd, end_time_s() * nd.omega_n);
+      setup_.motor.kind == MotorKind::Ideal && StuckForcingTable::supports(nd)) {
+    try {
+      stuck_table_ = StuckForcingTable::shared(setup_.profile, nd, end_time_s() * nd.omega_n);
+    } catch (const std::invalid_argument&) {
+      // a profile too long for a stored table (kMaxStoredIntervals): the Runge-Kutta path, in bounded memory
+    }
+  }
   if (setup_.motor.kind == MotorKind::PI && setup_.motor.feedforward.enabled)
     reference_ = std::make_shared<const StartupProfile>(feedforward_setpoint(setup_.profile, setup_.motor));
 }
@@ -377,7 +383,12 @@ RunOutcome Run::execute() {
 
   const bool tail_enabled = event_driven_ && rs_.opt.closed_form_tail && !tracing;
   bool integ_stale = false;  // the exact propagator moved (t, y): the stepper restarts from there
+  unsigned long passes = 0;
   while (t < t_end_) {
+    // the stop request (SIGINT / SIGTERM, common/stop.hpp): a run can take seconds (chatter, a
+    // long end time), so it ends here too, not only between runs; the batch runner then reports
+    // the interruption and no outcome of this run is kept
+    if ((++passes & 255u) == 0 && stop_requested()) throw Interrupted("interrupted by " + stop_signal_name());
     Integrator::Result res = Integrator::Ok;
     if (exact_stuck() && rs_.frozen) {
       // every ball stuck: the exact propagator, to the next stop time (a breakpoint, the end, or

@@ -92,6 +92,7 @@ OptimizationResult minimize(Problem& problem, const OptimizerOptions& options, s
   r.inequality_names = problem.inequality_names();
   r.equality_names = problem.equality_names();
   driver.fill(r);
+  if (driver.fatal_error()) std::rethrow_exception(driver.fatal_error());  // e.g. the archive cannot be written
 
   if (driver.stopped()) {  // our own stop (budget, time, callback, interrupt, error, target) wins
     r.reason = *driver.stop_reason();
