@@ -1,9 +1,6 @@
 // abuopt study STUDY.yaml: a whole design study from one declarative file (docs/study.md): stages
 // chained, every evaluation archived (a rerun resumes), and a report a designer reads. The work is
 // in studies/study.hpp; this file parses options, owns the Ctrl-C hook and prints.
-#include <csignal>
-
-#include <atomic>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -13,7 +10,7 @@
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/progress.hpp"
-#include "abuopt/optimizer/minimize.hpp"
+#include "abuopt/common/stop.hpp"
 #include "abuopt/studies/study.hpp"
 #include "commands/commands.hpp"
 
@@ -25,31 +22,6 @@ struct StudyArgs {
   std::string file, out;
   std::optional<long> threads;
   bool progress = false;
-};
-
-// The study's one Ctrl-C hook: the flag stops the stages between evaluations, and
-// opt::request_stop() stops a running optimiser (whose own handler replaces this one while it runs
-// and comes back after it).
-std::atomic<bool> g_stop{false};
-extern "C" void on_study_sigint(int) {
-  g_stop.store(true);
-  opt::request_stop();
-}
-
-class SigintScope {
- public:
-  SigintScope() {
-    struct sigaction sa {};
-    sa.sa_handler = on_study_sigint;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &previous_);
-  }
-  ~SigintScope() { sigaction(SIGINT, &previous_, nullptr); }
-  SigintScope(const SigintScope&) = delete;
-  SigintScope& operator=(const SigintScope&) = delete;
-
- private:
-  struct sigaction previous_ {};
 };
 
 int run_study_command(const StudyArgs& a) {
@@ -71,20 +43,28 @@ int run_study_command(const StudyArgs& a) {
     bar.set_total(static_cast<std::size_t>(total));
     bar.update(static_cast<std::size_t>(done));
   };
-  o.stop_requested = [] { return g_stop.load(); };
-  g_stop.store(false);
+  // SIGINT / SIGTERM (common/stop.hpp): the stages stop between evaluations, a running optimiser
+  // at its next evaluation; a Monte Carlo cut short outside an optimiser ends the study here.
+  o.stop_requested = [] { return stop_requested(); };
   studies::StudyResult r;
   {
-    SigintScope sigint;
-    r = studies::run_study(f, o);
+    const StopScope stop_scope;
+    try {
+      r = studies::run_study(f, o);
+    } catch (const Interrupted& e) {
+      bar.finish();
+      throw Interrupted(std::string(e.what()) + "; every finished evaluation is kept in " + out +
+                        "/archive.sqlite: rerun the same command to resume");
+    }
   }
   bar.finish();
   const auto files = studies::write_study_report(f, r, out);
   std::cout << "wrote " << out << "/report.html, report.md, summary.json and " << r.designs.size()
             << " designs in " << out << "/designs/ (" << r.wall_time_s << " s)\n";
   if (r.interrupted) {
-    std::cout << "interrupted: rerun the same command to resume from " << out << "/archive.sqlite\n";
-    return 130;
+    std::cerr << "abuopt: interrupted by " << stop_signal_name() << ": the partial report is written and every finished "
+              << "evaluation is kept in " << out << "/archive.sqlite; rerun the same command to resume\n";
+    return stop_signal() != 0 ? stop_exit_status() : 130;
   }
   if (!r.recommended) {
     std::cerr << "abuopt: the study recommends no design:";
@@ -108,7 +88,7 @@ void register_study(CLI::App& app) {
       "OUT/report.html, report.md, summary.json and designs/*.yaml (ready for abuopt montecarlo).\n"
       "Every evaluation is archived in OUT/archive.sqlite: rerunning the same command resumes.\n"
       "Exit status: 0 ok, 2 bad input, 3 no design recommended (the reason is printed), 4 an output\n"
-      "file could not be written, 130 interrupted (Ctrl-C).");
+      "file could not be written, 130 interrupted (Ctrl-C), 143 terminated (SIGTERM).");
   sub->add_option("study", args->file, "study file (YAML)")->required();
   sub->add_option("--out", args->out, "output directory (default results/<study file stem>)");
   sub->add_option("--threads", args->threads, "Monte Carlo worker threads (0 = all cores; results do not depend on it)");

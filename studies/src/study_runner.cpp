@@ -9,6 +9,7 @@
 #include <limits>
 #include <sstream>
 
+#include "abuopt/common/stop.hpp"
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/provenance.hpp"
 #include "abuopt/common/text.hpp"
@@ -271,18 +272,25 @@ StudyResult run_study(const StudyFile& f, const StudyRunOptions& o) {
   bool replicated = false;
   for (const StageSpec& s : f.stages) {
     if (c.stop()) break;
-    switch (s.kind) {
-      case StageKind::Global: run_global_stage(c, s); break;
-      case StageKind::Local: run_local_stage(c, s); break;
-      case StageKind::Replicate:
-        run_replicate_stage(c, s);
-        replicated = true;
-        break;
-      case StageKind::Validate:
-        if (!replicated) recommend_in_sample(c);
-        replicated = true;
-        run_validate_stage(c, s);
-        break;
+    try {
+      switch (s.kind) {
+        case StageKind::Global: run_global_stage(c, s); break;
+        case StageKind::Local: run_local_stage(c, s); break;
+        case StageKind::Replicate:
+          run_replicate_stage(c, s);
+          replicated = true;
+          break;
+        case StageKind::Validate:
+          if (!replicated) recommend_in_sample(c);
+          replicated = true;
+          run_validate_stage(c, s);
+          break;
+      }
+    } catch (const Interrupted&) {
+      // a stop request (common/stop.hpp) cut a Monte Carlo outside an optimiser: what is archived
+      // stays, the report is written from what is complete
+      c.interrupted = true;
+      break;
     }
   }
   if (!replicated) recommend_in_sample(c);
