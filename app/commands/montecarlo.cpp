@@ -83,7 +83,8 @@ void apply_overrides(const MonteCarloArgs& a, MonteCarloConfig& cfg) {
     s.seed = static_cast<std::uint64_t>(*a.seed);
     s.design.seed = s.seed;
   }
-  if (a.mu) {
+  if (a.mu) {  // replaces the friction of the config, wherever it was given
+    s.uncertain.envelope.friction_mu = ParameterDistribution{};
     s.uncertain.friction = FrictionUncertainty{};
     s.uncertain.friction.sampling = FrictionSampling::Fixed;
     s.uncertain.friction.value = *a.mu;
@@ -92,6 +93,7 @@ void apply_overrides(const MonteCarloArgs& a, MonteCarloConfig& cfg) {
 }
 
 std::string friction_text(const MonteCarloStudy& s) {
+  if (s.uncertain.envelope.friction_mu.given()) return s.uncertain.envelope.friction_mu.text();
   const FrictionUncertainty& f = s.uncertain.friction;
   switch (f.sampling) {
     case FrictionSampling::Nominal: return num_text(s.setup.abu.friction_mu);
@@ -120,6 +122,13 @@ nlohmann::json study_json(const MonteCarloArgs& a, const MonteCarloConfig& cfg, 
                       {"imbalance_without_balls_kgm", s.setup.abu.imbalance_kgm()},
                       {"profile_duration_s", s.setup.profile.duration_s()},
                       {"end_time_s", end_time_s}};
+  const Envelope& e = s.uncertain.envelope;
+  if (!e.empty()) {
+    nlohmann::json env = nlohmann::json::object();
+    for (std::size_t k = 0; k < Envelope::kParameters; ++k)
+      if (e.parameter(k).given()) env[Envelope::key(k)] = e.parameter(k).text();
+    j["envelope"] = env;
+  }
   if (d.kind == InitialConditionKind::Grid) j["grid"] = d.grid_points_per_axis;
   if (d.kind == InitialConditionKind::Halton || d.kind == InitialConditionKind::Sobol) j["shift"] = d.random_shift;
   return j;
@@ -210,8 +219,15 @@ int run_montecarlo(const MonteCarloArgs& a) {
     std::cout << ", " << s.runs << " runs, seed " << s.seed << ", mu " << friction_text(s) << "\n"
               << "  profile " << s.setup.profile.duration_s() << " s, end time " << end_time_s
               << " s, imbalance without balls I = " << std::setprecision(4) << s.setup.abu.imbalance_kgm() * 1e7
-              << "e-7 kg m\n"
-              << std::setprecision(6) << format_summary(stats);
+              << "e-7 kg m\n";
+    const Envelope& e = s.uncertain.envelope;
+    if (!e.empty()) {
+      std::cout << "  envelope (drawn per run):";
+      for (std::size_t k = 0; k < Envelope::kParameters; ++k)
+        if (e.parameter(k).given()) std::cout << " " << Envelope::key(k) << " " << e.parameter(k).text() << ";";
+      std::cout << "\n";
+    }
+    std::cout << std::setprecision(6) << format_summary(stats);
     std::cout << terms_text("");
     if (!a.out.empty())
       std::cout << "wrote " << a.out << "/runs.csv and " << a.out << "/summary.json\n"

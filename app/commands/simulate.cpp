@@ -51,7 +51,7 @@ int run_simulate(const SimulateArgs& a) {
   YamlReader root = YamlReader::load_file(a.config);
   SimulationSetup setup = read_simulation_setup(root);
   // A montecarlo section (a config that `abuopt montecarlo` also runs) is checked and not used.
-  if (root.has("montecarlo")) (void)read_monte_carlo_config(root, setup);
+  if (root.has("montecarlo") || root.has("envelope")) (void)read_monte_carlo_config(root, setup);
   root.finish();
   if (a.mu) {
     if (!(std::isfinite(*a.mu) && *a.mu >= 0 && *a.mu <= 0.999))

@@ -25,6 +25,8 @@ MonteCarloSample make_sample(const MonteCarloStudy& s, std::size_t index, std::v
   out.friction_mu = out.overrides.friction_mu.value_or(s.setup.abu.friction_mu);
   out.imbalance_kgm =
       out.overrides.imbalance_mass_kg.value_or(s.setup.abu.imbalance_mass_kg) * s.setup.abu.eccentricity_m;
+  out.stiffness_N_per_m = out.overrides.stiffness_N_per_m.value_or(s.setup.abu.stiffness_N_per_m);
+  out.restitution = out.overrides.ball_restitution.value_or(s.setup.abu.ball_restitution);
   return out;
 }
 
@@ -36,6 +38,8 @@ std::vector<double> exchange_key(const MonteCarloSample& smp) {
   k.push_back(smp.friction_mu);
   k.push_back(smp.imbalance_kgm);
   k.push_back(smp.overrides.imbalance_angle_rad);
+  k.push_back(smp.stiffness_N_per_m);
+  k.push_back(smp.restitution);
   return k;
 }
 
@@ -105,6 +109,9 @@ void validate(const MonteCarloStudy& s, const std::string& path) {
                           std::to_string(d.balls) + " = " + std::to_string(d.size()) +
                           " with the grid design (change grid, or use design random, lhs, halton or sobol)");
   validate(s.uncertain, path);
+  if (s.uncertain.envelope.restitution.given() && s.setup.abu.ball_contact != BallContact::Hard)
+    throw ConfigError("envelope.restitution", s.uncertain.envelope.restitution.text(),
+                      "needs abu.ball_contact: hard (restitution is the ball-ball impacts' coefficient)");
 }
 
 MonteCarloSample prepare_sample(const MonteCarloStudy& s, std::size_t index) {
@@ -231,12 +238,15 @@ MonteCarloConfig read_section(YamlReader& mc, SimulationSetup setup) {
 
 MonteCarloConfig read_monte_carlo_config_unchecked(YamlReader& root, SimulationSetup setup) {
   YamlReader mc = root.child("montecarlo");
-  return read_section(mc, std::move(setup));
+  MonteCarloConfig cfg = read_section(mc, std::move(setup));
+  cfg.study.uncertain.envelope = read_envelope(root);
+  return cfg;
 }
 
 MonteCarloConfig read_monte_carlo_config(YamlReader& root, SimulationSetup setup) {
   YamlReader mc = root.child("montecarlo");
   MonteCarloConfig cfg = read_section(mc, std::move(setup));
+  cfg.study.uncertain.envelope = read_envelope(root);
   validate(cfg.study, mc.path());
   return cfg;
 }

@@ -268,7 +268,7 @@ void write_runs_csv(std::ostream& os, const std::vector<MonteCarloSample>& sampl
   for (const auto& s : samples) n = std::max({n, s.beta0.size(), s.outcome.beta_final.size()});
   os << "index";
   for (std::size_t j = 1; j <= n; ++j) os << ",beta0_" << j;
-  os << ",mu,imbalance_mass_kg,imbalance_angle_rad";
+  os << ",mu,imbalance_mass_kg,imbalance_angle_rad,stiffness_N_per_m,restitution";
   for (std::size_t j = 1; j <= n; ++j) os << ",beta_final_" << j;
   os << ",ir_magnitude_kgm,ir_x_kgm,settled,settling_time_s,max_amplitude_mm,events,rhs_evaluations,status\n";
   for (const auto& s : samples) {
@@ -277,7 +277,7 @@ void write_runs_csv(std::ostream& os, const std::vector<MonteCarloSample>& sampl
     for (std::size_t j = 0; j < n; ++j) os << ',' << (j < s.beta0.size() ? num(s.beta0[j]) : "");
     os << ',' << num(s.friction_mu) << ','
        << (s.overrides.imbalance_mass_kg ? num(*s.overrides.imbalance_mass_kg) : std::string()) << ','
-       << num(s.overrides.imbalance_angle_rad);
+       << num(s.overrides.imbalance_angle_rad) << ',' << num(s.stiffness_N_per_m) << ',' << num(s.restitution);
     for (std::size_t j = 0; j < n; ++j) os << ',' << (j < o.beta_final.size() ? num(o.beta_final[j]) : "");
     os << ',' << num(o.residual_imbalance_kgm) << ',' << num(o.residual_imbalance_x_kgm) << ','
        << (o.settled ? 1 : 0) << ',' << num(o.settling_time_s) << ',' << num(o.max_amplitude_mm) << ',' << o.events

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "root_refine.hpp"
+#include "run_forcing_table.hpp"
 
 namespace abuopt::detail {
 
@@ -16,6 +17,9 @@ namespace {
 
 constexpr int kNodes = 7;               // Gauss-Legendre nodes per interval
 constexpr double kCheckFraction = 0.5;  // grid spacing / period of the fastest margin oscillation
+
+
+}  // namespace
 
 // Gauss-Legendre nodes and weights on [0, 1] (Newton on the Legendre polynomial).
 void gauss_legendre(int m, std::vector<double>& x, std::vector<double>& w) {
@@ -49,7 +53,6 @@ void gauss_legendre(int m, std::vector<double>& x, std::vector<double>& w) {
   }
 }
 
-}  // namespace
 
 bool StuckForcingTable::supports(const NondimParameters& nd) {
   return nd.bbar > 0 && std::fabs(nd.bbar - 1.0) > 1e-6 && std::isfinite(nd.bbar) && nd.omega_n > 0;
@@ -234,7 +237,8 @@ void StuckForcingTable::partial(double t0, double h, cplx P[2]) const {
   }
 }
 
-StuckPropagator::StuckPropagator(const StuckForcingTable& tab, RunState& rs, RootFn g)
+template <class Table>
+StuckPropagatorT<Table>::StuckPropagatorT(const Table& tab, RunState& rs, RootFn g)
     : tab_(tab), rs_(rs), g_(g) {
   ywork_.resize(rs.lay().size());
   g0_.resize(rs.nroots());
@@ -243,7 +247,8 @@ StuckPropagator::StuckPropagator(const StuckForcingTable& tab, RunState& rs, Roo
   L_mm_ = rs.params.ball_track_radius_m * 1e3;
 }
 
-void StuckPropagator::to_modal(double t, const double* y) {
+template <class Table>
+void StuckPropagatorT<Table>::to_modal(double t, const double* y) {
   double W, Wp;
   cplx e;
   tab_.sample(t, W, Wp, e);
@@ -256,7 +261,8 @@ void StuckPropagator::to_modal(double t, const double* y) {
   a_[1] = r * (l1 * Z - Zd);
 }
 
-void StuckPropagator::from_modal(const cplx a[2], double W, const cplx& rot, double* y) const {
+template <class Table>
+void StuckPropagatorT<Table>::from_modal(const cplx a[2], double W, const cplx& rot, double* y) const {
   const cplx Z = a[0] + a[1], Zd = tab_.lambda(0) * a[0] + tab_.lambda(1) * a[1];
   const cplx z = Z * rot, zd = Zd * rot - cplx(0, W) * z;
   y[StateLayout::x] = z.real();
@@ -265,7 +271,8 @@ void StuckPropagator::from_modal(const cplx a[2], double W, const cplx& rot, dou
   y[StateLayout::y_dot] = zd.imag();
 }
 
-void StuckPropagator::state_at(double t0, const cplx a0[2], double t, double* y) const {
+template <class Table>
+void StuckPropagatorT<Table>::state_at(double t0, const cplx a0[2], double t, double* y) const {
   cplx P[2];
   tab_.partial(t0, t - t0, P);
   cplx a[2];
@@ -277,7 +284,8 @@ void StuckPropagator::state_at(double t0, const cplx a0[2], double t, double* y)
 }
 
 // Illinois on the exact solution (the stepper's polished roots, docs/model.md 11.5).
-double StuckPropagator::locate(std::size_t k, double ta, double ga, double tb, double gb, const cplx a0[2], double t0) {
+template <class Table>
+double StuckPropagatorT<Table>::locate(std::size_t k, double ta, double ga, double tb, double gb, const cplx a0[2], double t0) {
   std::vector<double> yc(ywork_);
   auto g = [&](double tc) {
     state_at(t0, a0, tc, yc.data());
@@ -294,7 +302,8 @@ double StuckPropagator::locate(std::size_t k, double ta, double ga, double tb, d
 //   with u = conj(e_i) z, v = conj(e_i) z', a = conj(e_i) z'' (e_i = e^{i beta_i}):
 //   fn_i = -(Re a - 2 W Im v - W^2 Re u - W^2 - W' Im u),
 //   fw_i = -(Im a + 2 W Re v - W^2 Im u + W' (Re u + 1 - 2 dbar_i Jbar)).
-void StuckPropagator::margins(double W, double Wp, const double* y, double* g) {
+template <class Table>
+void StuckPropagatorT<Table>::margins(double W, double Wp, const double* y, double* g) {
   const cplx z(y[StateLayout::x], y[StateLayout::y]), zd(y[StateLayout::x_dot], y[StateLayout::y_dot]);
   const double bb = rs_.nd.bbar, W2 = W * W;
   const cplx zdd = C_ * cplx(W2, -Wp) - cplx(2 * bb, 2 * W) * zd - cplx(1 - W2, Wp + 2 * bb * W) * z;
@@ -310,7 +319,8 @@ void StuckPropagator::margins(double W, double Wp, const double* y, double* g) {
   }
 }
 
-StuckPropagator::Result StuckPropagator::advance(double& t, std::vector<double>& y, double tstop,
+template <class Table>
+typename StuckPropagatorT<Table>::Result StuckPropagatorT<Table>::advance(double& t, std::vector<double>& y, double tstop,
                                                  std::vector<int>& roots, double& peak_amp_mm) {
   const std::size_t n = rs_.n;
   C_ = cplx(rs_.nd.mbar_I * rs_.nd.ebar, 0.0);
@@ -389,5 +399,8 @@ StuckPropagator::Result StuckPropagator::advance(double& t, std::vector<double>&
   std::copy(ywork_.begin(), ywork_.begin() + StateLayout::table_size, y.begin());
   return Stop;
 }
+
+template class StuckPropagatorT<StuckForcingTable>;
+template class StuckPropagatorT<RunForcingTable>;
 
 }  // namespace abuopt::detail

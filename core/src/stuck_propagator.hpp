@@ -79,12 +79,21 @@ class StuckForcingTable {
   std::vector<cplx> E_, P_, rot_;
 };
 
+// Gauss-Legendre nodes on [0, 1] and their weights (sum 1), m nodes.
+void gauss_legendre(int m, std::vector<double>& x, std::vector<double>& w);
+
+struct StuckPropagatorResult {
+  enum Result { Stop, Root, NotFinite };
+};
+
 // One run's use of the table: from a state with every ball stuck, advance to a stop time or to the
 // earliest root of the stick functions (the integrator's root functions, offsets included).
-class StuckPropagator {
+// Table: StuckForcingTable (the Simulator's, shared: runs with its omega_n and bbar) or
+// RunForcingTable (run_forcing_table.hpp: a run with its own, e.g. an uncertain stiffness).
+template <class Table>
+class StuckPropagatorT : public StuckPropagatorResult {
  public:
-  enum Result { Stop, Root, NotFinite };
-  StuckPropagator(const StuckForcingTable& tab, RunState& rs, RootFn g);
+  StuckPropagatorT(const Table& tab, RunState& rs, RootFn g);
   // On Root: t and y are at the root (on the far side of the crossing, as the stepper's roots),
   // roots[k] != 0 marks the functions that crossed. NotFinite: the state is not finite (NaN or
   // inf, e.g. from a non-finite angle); t and y are where it was found. The peak table amplitude [mm] over the grid
@@ -99,7 +108,7 @@ class StuckPropagator {
   void margins(double W, double Wp, const double* y, double* g);
   double locate(std::size_t k, double ta, double ga, double tb, double gb, const cplx a0[2], double t0);
 
-  const StuckForcingTable& tab_;
+  const Table& tab_;
   RunState& rs_;
   RootFn g_;
   cplx C_;
@@ -109,5 +118,9 @@ class StuckPropagator {
   long intervals_ = 0;
   double L_mm_ = 0;
 };
+
+using StuckPropagator = StuckPropagatorT<StuckForcingTable>;
+class RunForcingTable;
+using RunStuckPropagator = StuckPropagatorT<RunForcingTable>;
 
 }  // namespace abuopt::detail

@@ -52,7 +52,7 @@ py::dict outcome_dict(const RunOutcome& o) {
 py::dict simulate(const py::handle& config, const std::vector<double>& beta0) {
   YamlReader root = load_config(config);
   SimulationSetup setup = read_simulation_setup(root);
-  if (root.has("montecarlo")) (void)read_monte_carlo_config(root, setup);
+  if (root.has("montecarlo") || root.has("envelope")) (void)read_monte_carlo_config(root, setup);
   root.finish();
   const std::size_t n = setup.abu.balls.size();
   if (beta0.size() != n)

@@ -64,6 +64,8 @@ struct MonteCarloSample {
   RunOverrides overrides;
   double friction_mu = 0;     // effective mu of this run (override or nominal)
   double imbalance_kgm = 0;   // effective m_I e of this run: the %MI threshold
+  double stiffness_N_per_m = 0;  // effective k of this run
+  double restitution = 0;        // effective ball-ball restitution of this run
   RunOutcome outcome;
 };
 
@@ -152,6 +154,7 @@ struct MonteCarloConfig {
 //   shift: true       halton/sobol: Cranley-Patterson random shift from the seed
 //   threads: 0        0 = all cores
 //   friction: {...}, imbalance: {...}   (uncertain_parameters.hpp)
+// and the top-level `envelope` section (envelope.hpp) into study.uncertain.envelope.
 // `setup` (read before, e.g. by read_simulation_setup) becomes study.setup. Validates the study.
 // The caller still calls root.finish().
 MonteCarloConfig read_monte_carlo_config(YamlReader& root, SimulationSetup setup);

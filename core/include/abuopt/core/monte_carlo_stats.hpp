@@ -117,7 +117,7 @@ SmoothImbalanceStats compute_smooth_statistics(const std::vector<MonteCarloSampl
 
 // Per-run CSV: header, then one line per sample in index order. Columns:
 // index, beta0_1..beta0_N, mu, imbalance_mass_kg (empty when nominal), imbalance_angle_rad,
-// beta_final_1..beta_final_N, ir_magnitude_kgm, ir_x_kgm, settled, settling_time_s,
+// stiffness_N_per_m, restitution (this run's effective values: the envelope's draws), beta_final_1..beta_final_N, ir_magnitude_kgm, ir_x_kgm, settled, settling_time_s,
 // max_amplitude_mm, events, rhs_evaluations, status. Numbers round-trip exactly (shortest form).
 void write_runs_csv(std::ostream& os, const std::vector<MonteCarloSample>& samples);
 
