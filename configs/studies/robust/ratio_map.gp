@@ -16,7 +16,7 @@ awk = sprintf("awk -F, -v nb=%d 'FNR==1{for(i=1;i<=NF;i++)c[$i]=i;f++;next} $c[\
 system(awk)
 set xlabel "friction mu"
 set ylabel "imbalance mass / 5.6e-4 kg"
-set title sprintf("2003 profile / %s: ratio of mean |I_r| (>1: design better), %d x %d bins", title, nb, nb)
+set title sprintf("mean |I_r| of the 2003 profile / of %s (>1: design better), %d x %d bins;\nlabels: ratio (2003 mean / design mean) [1e-7 kg m]", title, nb, nb)
 set cbrange [0.5:2.0]
 set palette defined (0.5 "#b2182b", 1.0 "#f7f7f7", 2.0 "#2166ac")
 set xrange [0.02:0.04]
