@@ -181,6 +181,23 @@ def main():
         check(dt < 15 and 1 <= n < 400, f"KeyboardInterrupt after {dt:.1f} s, {n} of 400 points archived")
     timer.cancel()
 
+    # 8. Ctrl-C during pareto ends the series: no further bound is started (30 bounds, 10 evaluations each)
+    many = work("pareto_many.yaml")
+    with open(many, "w") as f:
+        f.write(quick_text.replace("  max_startup_time_s: 20\n", "")
+                + "pareto:\n  max_startup_time_s: [" + ", ".join(str(5 + k) for k in range(30)) + "]\n")
+    timer = threading.Timer(1.0, _thread.interrupt_main)
+    t = time.time()
+    timer.start()
+    try:
+        abuopt.pareto(many, threads=2, out=work("py_pareto_ctrl_c"))
+        check(False, "Ctrl-C raises KeyboardInterrupt in pareto")
+    except KeyboardInterrupt:
+        dt = time.time() - t
+        probs = abuopt.Archive(os.path.join(work("py_pareto_ctrl_c"), "archive.sqlite")).problems()
+        check(dt < 10 and 1 <= len(probs) < 30, f"pareto: KeyboardInterrupt after {dt:.1f} s, {len(probs)} of 30 bounds started")
+    timer.cancel()
+
     if failures:
         print(f"{len(failures)} check(s) failed")
         return 1
