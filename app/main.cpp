@@ -11,6 +11,7 @@
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/provenance.hpp"
+#include "abuopt/common/stop.hpp"
 #include "abuopt/common/suggest.hpp"
 #include "abuopt/parallel/parallel.hpp"
 #include "abuopt/studies/terms.hpp"
@@ -67,7 +68,8 @@ int run_cli(int argc, char** argv) {
       "Exit status of every command: 0 ok; 2 bad input (config, option or value; the message names the\n"
       "key, value and rule); 3 the computation gave no usable result (every run failed, no feasible\n"
       "design, an evaluation error ended it, out of memory); 4 an output file could not be written (disk\n"
-      "full, no permission: nothing half-written is left under its name); 130 interrupted (Ctrl-C).\n"
+      "full, no permission: nothing half-written is left under its name); 130 interrupted (Ctrl-C, SIGINT),\n"
+      "143 terminated (SIGTERM): what is complete is kept and the message says what.\n"
       "docs/security.md says what abuopt trusts, where it writes and how it runs gnuplot."};
   app.require_subcommand(1);
   app.set_version_flag("--version", "abuopt " + abuopt::abuopt_version() + " (" + abuopt::abuopt_git_commit() + ")");
@@ -88,9 +90,9 @@ int run_cli(int argc, char** argv) {
     app.exit(e);
     if (const std::string hint = abuopt::app::hint_for(app, argc, argv); !hint.empty()) std::cerr << hint << "\n";
     return 2;
-  } catch (const abuopt::parallel::Interrupted& e) {  // SIGTERM under mpirun (Ctrl-C), docs/cluster.md
+  } catch (const abuopt::Interrupted& e) {  // SIGINT / SIGTERM (abuopt/common/stop.hpp; under mpirun docs/cluster.md)
     std::cerr << "abuopt: " << e.what() << "\n";
-    return 130;
+    return abuopt::stop_exit_status();
   } catch (const abuopt::ConfigError& e) {
     std::cerr << "abuopt: error: " << e.what() << "\n";
     return 2;
@@ -121,5 +123,8 @@ int main(int argc, char** argv) {
   std::signal(SIGXFSZ, SIG_IGN);
   abuopt::parallel::Session mpi(argc, argv);
   if (!mpi.is_root()) return mpi.serve();
+  // SIGINT and SIGTERM: a command that polls the stop request (StopScope) stops at its next safe
+  // point, keeps what is complete and exits 130 / 143; any other ends at once (docs/security.md)
+  abuopt::install_stop_handlers();
   return mpi.finish(run_cli(argc, argv));
 }

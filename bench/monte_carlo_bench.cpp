@@ -9,16 +9,32 @@
 //     of every study: 528 simulations for the 1024-run grid), R = 0: every run simulated (1024
 //     simulations); counters runs_per_s, s_per_run (wall time per run, all threads together) and
 //     simulations.
+// BM_UncertainParameterCost/param:P  the price of a parameter drawn per run (issue 32): the
+//     2003 profile with hard contact, ABUOPT_BENCH_RUNS (default 256) random starts, one thread;
+//     P = 0 friction_mu, 1 imbalance_mass_factor, 2 stiffness_factor, 3 restitution (each uniform
+//     over configs/envelope.yaml's range), 4 all four, 5 imbalance_mass_factor U[1, 1 + 1e-6] (an
+//     uncertain imbalance that is effectively constant, against the same Simulator's nominal
+//     runs). Run i of the study (its overrides) and run i as a nominal run of a Simulator built
+//     with run i's values run back to back; each
+//     best of three in thread CPU time. Counters: ratio = sum of the study's run times / sum of the nominal runs'
+//     (1.0: an uncertain parameter costs nothing), ms_per_run of both, and differ = runs whose
+//     |I_r| differs by more than 1e-9 relative (expected 0: the same physics).
 // BM_ParallelEfficiency  the study without reuse on 1 and then 2 threads; counters t1_s, t2_s,
 //     speedup = t1/t2 and efficiency = speedup / 2 (1.0 = perfect scaling). On a machine shared
 //     with other jobs the figures are lower bounds.
 #include <benchmark/benchmark.h>
 
+#include <time.h>
+
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
+#include <memory>
 #include <string>
 
 #include "abuopt/core/monte_carlo.hpp"
 #include "abuopt/core/monte_carlo_stats.hpp"
+#include "abuopt/core/simulator.hpp"
 
 namespace {
 
@@ -102,6 +118,82 @@ void BM_ParallelEfficiency(benchmark::State& state) {
   state.counters["efficiency"] = t1 / (2.0 * t2);
 }
 BENCHMARK(BM_ParallelEfficiency)->Iterations(1)->UseManualTime()->Unit(benchmark::kSecond);
+
+// CPU time of this thread [s]: on a machine shared with other jobs, wall time measures them too.
+double thread_cpu_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+void BM_UncertainParameterCost(benchmark::State& state) {
+  const long param = state.range(0);
+  MonteCarloStudy s;
+  s.reuse_exchangeable = false;
+  s.setup.profile = StartupProfile::report_final();
+  s.setup.abu.ball_contact = BallContact::Hard;
+  s.design.kind = InitialConditionKind::Random;
+  s.design.seed = 32;
+  s.seed = 32;
+  const char* e = std::getenv("ABUOPT_BENCH_RUNS");
+  s.runs = e && std::strtol(e, nullptr, 10) > 0 ? static_cast<std::size_t>(std::strtol(e, nullptr, 10)) : 256;
+  const Envelope full = Envelope::report();
+  if (param == 4) {
+    s.uncertain.envelope = full;
+  } else if (param == 5) {
+    s.uncertain.envelope.imbalance_mass_factor = ParameterDistribution::uniform(1.0, 1.0 + 1e-6);
+  } else {
+    s.uncertain.envelope.parameter(static_cast<std::size_t>(param)) = full.parameter(static_cast<std::size_t>(param));
+  }
+  const PreparedStudy p = prepare_study(s);
+  const Simulator study_sim(s.setup);
+  double t_study = 0, t_nominal = 0;
+  std::size_t differ = 0;
+  for (auto _ : state) {
+    t_study = t_nominal = 0;
+    differ = 0;
+    for (const MonteCarloSample& smp : p.samples) {
+      SimulationSetup at = s.setup;
+      at.abu.friction_mu = smp.friction_mu;
+      at.abu.imbalance_mass_kg = smp.overrides.imbalance_mass_kg.value_or(at.abu.imbalance_mass_kg);
+      at.abu.stiffness_N_per_m = smp.stiffness_N_per_m;
+      at.abu.ball_restitution = smp.restitution;
+      // built outside the timing (its table: the nominal's price); P = 5 compares with the
+      // study's own Simulator without the override (values equal to 1e-6: the issue's measurement)
+      const std::unique_ptr<const Simulator> own = param == 5 ? nullptr : std::make_unique<const Simulator>(at);
+      const Simulator& nominal_sim = own ? *own : study_sim;
+      RunOverrides angle_only;
+      angle_only.imbalance_angle_rad = smp.overrides.imbalance_angle_rad;
+      double a = 1e300, b = 1e300, ir_a = 0, ir_b = 0;
+      for (int rep = 0; rep < 3; ++rep) {
+        const double t0 = thread_cpu_s();
+        const RunOutcome ou = study_sim.run(smp.beta0, smp.overrides);
+        const double t1 = thread_cpu_s();
+        const RunOutcome on = nominal_sim.run(smp.beta0, angle_only);
+        const double t2 = thread_cpu_s();
+        a = std::min(a, t1 - t0);
+        b = std::min(b, t2 - t1);
+        ir_a = ou.residual_imbalance_kgm;
+        ir_b = on.residual_imbalance_kgm;
+      }
+      t_study += a;
+      t_nominal += b;
+      if (std::fabs(ir_a - ir_b) > 1e-9 * std::max(std::fabs(ir_b), 1e-12)) ++differ;
+    }
+    state.SetIterationTime(t_study + t_nominal);
+  }
+  state.counters["runs"] = static_cast<double>(s.runs);
+  state.counters["ratio"] = t_study / t_nominal;
+  state.counters["study_ms_per_run"] = 1e3 * t_study / static_cast<double>(s.runs);
+  state.counters["nominal_ms_per_run"] = 1e3 * t_nominal / static_cast<double>(s.runs);
+  state.counters["differ"] = static_cast<double>(differ);
+}
+BENCHMARK(BM_UncertainParameterCost)
+    ->ArgName("param")
+    ->DenseRange(0, 5)
+    ->Iterations(1)
+    ->UseManualTime()
+    ->Unit(benchmark::kSecond);
 
 }  // namespace
 

@@ -44,7 +44,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   app.require_subcommand(1);
   app.set_version_flag("--version", "abuopt fuzz");
   abuopt::app::register_all(app);
-  app.parse_complete_callback([] { throw ParsedOnly{}; });
+  // the option-value checks of register_all, then stop before any command runs
+  app.parse_complete_callback([&app] {
+    abuopt::app::check_option_values(app);
+    throw ParsedOnly{};
+  });
 
   std::vector<const char*> argv;
   for (const auto& a : args) argv.push_back(a.c_str());

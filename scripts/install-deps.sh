@@ -10,6 +10,8 @@ packages=(
   libyaml-cpp-dev        # study configs
   libnlopt-dev libnlopt-cxx-dev  # NLopt optimisers (C API + C++ wrapper; the CMake config is in libnlopt-dev)
   coinor-libipopt-dev    # Ipopt
+  libpagmo-dev           # pagmo2 optimisers (CMA-ES, xNES, SADE, PSO; links TBB and Boost.Serialization)
+  python3-optuna         # examples/python/optuna_study.py (TPE, CMA-ES samplers; exits 0 without it)
   libsqlite3-dev         # evaluation archive
   libopenmpi-dev openmpi-bin  # MPI across ranks (parallel/, option ABUOPT_MPI; docs/cluster.md)
   libcli11-dev           # command line parsing
@@ -22,6 +24,7 @@ packages=(
   python3                # scripts/startup_study.py, scripts/final_states_in_set.py (standard library only)
   python3-dev pybind11-dev python3-numpy  # the Python module abuopt (python/; skipped without them)
   python3-scipy python3-matplotlib        # examples/python (each says so and exits 0 without its package)
+  chromium               # headless browser: the test that opens abuopt study's report.html (tests/app/study_cli_test.py)
   python3-yaml           # scripts/stop_distribution.py reads configs (and its test)
 )
 

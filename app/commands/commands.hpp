@@ -18,7 +18,11 @@ void register_optimize(CLI::App& app);
 void register_sweep(CLI::App& app);
 void register_pareto(CLI::App& app);
 void register_archive(CLI::App& app);
+void register_study(CLI::App& app);
 // Every subcommand above, in the order of `abuopt --help` (commands/register_all.cpp).
 void register_all(CLI::App& app);
+// Every option value given (empty, non-finite, out of range): ConfigError naming the option
+// (commands/option_values.cpp). register_all runs it after parsing, before the command.
+void check_option_values(const CLI::App& app);
 
 }  // namespace abuopt::app

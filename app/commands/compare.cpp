@@ -22,6 +22,9 @@
 //   solvers:
 //     - {label: SAO, algorithm: sao, sao: {...}}
 //     - {label: COBYLA, algorithm: cobyla, options: {...}}   # options: the optimizer: keys
+//     - {label: CMA-ES, algorithm: pagmo_cmaes}             # pagmo2: pagmo_cmaes/xnes/sade/pso
+//     - {label: Optuna-TPE, external: DIR}    # runs made elsewhere: DIR/<problem>/start<k>.csv
+//                                             # (examples/python/optuna_study.py; docs/benchmarks.md)
 //
 // Resumable: every run keeps its evaluations in OUT/archive/<problem>/start<k>-<solver>.sqlite (and
 // the validations in OUT/archive/<problem>/validation.sqlite); the same command with the same --out
@@ -37,6 +40,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "abuopt/common/stop.hpp"
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/progress.hpp"
@@ -184,8 +188,14 @@ int run_compare(const CompareArgs& a) {
     bar.message(line.str());
     bar.update(ended);
   };
+  const StopScope stop_scope;  // SIGINT / SIGTERM end every run after its current evaluation
   const opt::ComparisonResult result = opt::run_comparison(setup);
   bar.finish();
+  if (stop_requested())  // the tables and profiles need every run: none is written
+    throw Interrupted("interrupted by " + stop_signal_name() + ": kept " + std::to_string(computed_evaluations) +
+                      " computed evaluations in " + setup.archive_directory +
+                      "; no result file is written (the comparison needs every run); rerun the same command "
+                      "with --out " + out + " to resume");
   std::cerr << "compare: " << computed_evaluations << " evaluations computed, " << archived_evaluations
             << " answered from the archive (" << setup.archive_directory << ")\n";
 
@@ -235,6 +245,29 @@ int run_compare(const CompareArgs& a) {
     for (const auto& s : files.skipped_plots) std::cerr << " " << s;
     std::cerr << "\n";
   }
+  // A solver that evaluated no point in any run (it refused every start, or failed before
+  // evaluating) has no place in the profiles: the comparison is then no usable result (exit 3).
+  std::vector<std::string> idle;
+  for (const std::string& solver : result.solvers) {
+    const opt::RunRecord* example = nullptr;
+    bool evaluated = false;
+    for (const auto& r : result.runs)
+      if (r.solver == solver) {
+        evaluated = evaluated || r.result.evaluations > 0;
+        if (!example) example = &r;
+      }
+    if (!evaluated && example) {
+      idle.push_back(solver);
+      std::cerr << "abuopt: solver " << solver << " evaluated no point in any run: "
+                << opt::to_string(example->result.reason)
+                << (example->result.message.empty() ? std::string() : " (" + example->result.message + ")") << "\n";
+    }
+  }
+  if (!idle.empty()) {
+    std::cerr << "abuopt: the comparison is incomplete (" << idle.size() << " of " << result.solvers.size()
+              << " solvers evaluated nothing)\n";
+    return 3;
+  }
   return 0;
 }
 
@@ -249,7 +282,8 @@ void register_compare(CLI::App& app) {
       "time), convergence curves, data profiles and performance profiles (CSV, and PNG + PDF with gnuplot).\n"
       "Every evaluation is archived in OUT/archive/: rerunning the same command (same config, same --out or\n"
       "none) after an interruption resumes (stored evaluations are answered from the archive, bit for bit).\n"
-      "Exit status: 0 ok, 2 bad input.");
+      "Exit status: 0 ok, 2 bad input, 3 a solver evaluated no point in any run, 4 an output file could not be written,\n"
+      "130 interrupted (Ctrl-C), 143 terminated (SIGTERM): the archive keeps every finished evaluation.");
   sub->add_option("config", args->config, "YAML config (tau, problems, solvers; see configs/compare/)")->required();
   sub->add_option("--out", args->out,
                   "output directory (default results/compare-<config stem>/: a rerun of the same config resumes there)");

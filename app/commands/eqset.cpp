@@ -15,6 +15,7 @@
 
 #include "abuopt/common/config_sections.hpp"
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/common/number_text.hpp"
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/config_fields.hpp"
 #include "abuopt/common/gnuplot.hpp"
@@ -32,8 +33,7 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr long kMaxGrid = 4096;
-// The steady amplitude grows with (2 pi f)^4 terms: 1e6 Hz keeps every product finite.
-constexpr double kMaxFrequencyHz = 1e6;
+constexpr double kMaxFrequencyHz = kMaxEquilibriumFrequencyHz;
 constexpr std::size_t kMaxScanPoints = 100000;
 
 struct EqsetArgs {
@@ -68,25 +68,17 @@ void check_scan(const Scan& s, const std::string& option, const std::string& tex
   if (!(std::isfinite(s.from) && std::isfinite(s.to) && std::isfinite(s.step)) || !(s.from > 0) ||
       !(s.to >= s.from) || !(s.step > 0))
     throw ConfigError(option, text, rule);
+  if (s.to > kMaxFrequencyHz)  // the cap of --freq holds for every frequency of the scan
+    throw ConfigError(option, text, "must stay within (0, 1e6] Hz (above it the steady amplitude overflows double "
+                                    "precision), as --freq");
   if ((s.to - s.from) / s.step + 1 > static_cast<double>(kMaxScanPoints))
     throw ConfigError(option, text, "must give at most " + std::to_string(kMaxScanPoints) + " frequencies");
 }
 
 Scan parse_scan(const std::string& text) {
-  std::vector<double> v;
-  std::stringstream ss(text);
-  std::string item;
   const std::string rule = "must be FROM:TO:STEP in Hz with 0 < FROM <= TO and STEP > 0";
-  while (std::getline(ss, item, ':')) {
-    try {
-      std::size_t used = 0;
-      v.push_back(std::stod(item, &used));
-      if (used != item.size()) throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      throw ConfigError("--scan", text, rule);
-    }
-  }
-  if (v.size() != 3 || text.back() == ':') throw ConfigError("--scan", text, rule);
+  const std::vector<double> v = parse_number_list(text, ':', "--scan", rule);
+  if (v.size() != 3) throw ConfigError("--scan", text, rule);
   Scan s{v[0], v[1], v[2]};
   check_scan(s, "--scan", text);
   return s;
@@ -121,9 +113,12 @@ nlohmann::json band_json(const std::optional<std::pair<double, double>>& b) {
 }
 
 fs::path make_out_dir(const std::string& dir, const std::string& option) {
+  // an output that cannot be made is a write failure (exit 4), as for every other command
   std::error_code ec;
   fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir)) throw ConfigError(option, dir, "must be a directory that can be created and written");
+  if (ec || !fs::is_directory(dir))
+    throw OutputError("cannot create the output directory " + dir + " (" + option + ": " +
+                      (ec ? ec.message() : std::string("not a directory")) + ")");
   return fs::path(dir);
 }
 

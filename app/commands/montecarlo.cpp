@@ -21,6 +21,7 @@
 #include "abuopt/common/plot_style.hpp"
 #include "abuopt/common/text.hpp"
 #include "abuopt/common/progress.hpp"
+#include "abuopt/common/stop.hpp"
 #include "abuopt/common/provenance.hpp"
 #include "abuopt/core/monte_carlo.hpp"
 #include "abuopt/core/monte_carlo_stats.hpp"
@@ -84,7 +85,8 @@ void apply_overrides(const MonteCarloArgs& a, MonteCarloConfig& cfg) {
     s.seed = static_cast<std::uint64_t>(*a.seed);
     s.design.seed = s.seed;
   }
-  if (a.mu) {
+  if (a.mu) {  // replaces the friction of the config, wherever it was given
+    s.uncertain.envelope.friction_mu = ParameterDistribution{};
     s.uncertain.friction = FrictionUncertainty{};
     s.uncertain.friction.sampling = FrictionSampling::Fixed;
     s.uncertain.friction.value = *a.mu;
@@ -93,6 +95,7 @@ void apply_overrides(const MonteCarloArgs& a, MonteCarloConfig& cfg) {
 }
 
 std::string friction_text(const MonteCarloStudy& s) {
+  if (s.uncertain.envelope.friction_mu.given()) return s.uncertain.envelope.friction_mu.text();
   const FrictionUncertainty& f = s.uncertain.friction;
   switch (f.sampling) {
     case FrictionSampling::Nominal: return num_text(s.setup.abu.friction_mu);
@@ -121,6 +124,13 @@ nlohmann::json study_json(const MonteCarloArgs& a, const MonteCarloConfig& cfg, 
                       {"imbalance_without_balls_kgm", s.setup.abu.imbalance_kgm()},
                       {"profile_duration_s", s.setup.profile.duration_s()},
                       {"end_time_s", end_time_s}};
+  const Envelope& e = s.uncertain.envelope;
+  if (!e.empty()) {
+    nlohmann::json env = nlohmann::json::object();
+    for (std::size_t k = 0; k < Envelope::kParameters; ++k)
+      if (e.parameter(k).given()) env[Envelope::key(k)] = e.parameter(k).text();
+    j["envelope"] = env;
+  }
   if (d.kind == InitialConditionKind::Grid) j["grid"] = d.grid_points_per_axis;
   if (d.kind == InitialConditionKind::Halton || d.kind == InitialConditionKind::Sobol) j["shift"] = d.random_shift;
   return j;
@@ -186,12 +196,31 @@ int run_montecarlo(const MonteCarloArgs& a) {
       bar.set_total(total);
       bar.update(done);
     };
-  const MonteCarloResult result = run_monte_carlo(s, *runner, progress);
+  const StopScope stop_scope;  // SIGINT / SIGTERM stop the runs (abuopt/common/stop.hpp)
+  MonteCarloResult result;
+  try {
+    result = run_monte_carlo(s, *runner, progress);
+  } catch (const Interrupted& e) {
+    bar.finish();
+    throw Interrupted(std::string(e.what()) + "; nothing written (the statistics need every run" +
+                      (a.out.empty() ? "" : ", " + a.out + " is unchanged") +
+                      "); a rerun computes the same runs and the same result");
+  }
   bar.finish();
   const MonteCarloStats stats = compute_statistics(result);
 
   nlohmann::json summary = to_json(stats);
   summary["study"] = study_json(a, cfg, end_time_s);
+  // the interval of the mean: from the replicate means under the envelope's scrambled Sobol' draws
+  const IntervalLayout layout = interval_layout(s);
+  const double hw = mean_half_width95(result.samples, layout), hw_x = mean_half_width95(result.samples, layout, true);
+  const std::string interval_text =
+      layout.kind == IntervalKind::Replicates ? "from the means of 16 scrambled Sobol' replicates"
+      : layout.kind == IntervalKind::Strata   ? "stratified: " + std::to_string(layout.groups) + " cells of the envelope"
+                                              : "independent runs";
+  summary["magnitude"]["mean_ci95_half_width"] = hw;
+  summary["report_x"]["mean_ci95_half_width"] = hw_x;
+  summary["study"]["mean_interval"] = interval_text;
   const Provenance prov = provenance_of(a.config);
   summary["provenance"] = {{"abuopt_version", prov.abuopt_version},
                            {"git_commit", prov.git_commit},
@@ -218,8 +247,19 @@ int run_montecarlo(const MonteCarloArgs& a) {
     std::cout << ", " << s.runs << " runs, seed " << s.seed << ", mu " << friction_text(s) << "\n"
               << "  profile " << s.setup.profile.duration_s() << " s, end time " << end_time_s
               << " s, imbalance without balls I = " << std::setprecision(4) << s.setup.abu.imbalance_kgm() * 1e7
-              << "e-7 kg m\n"
-              << std::setprecision(6) << format_summary(stats);
+              << "e-7 kg m\n";
+    const Envelope& e = s.uncertain.envelope;
+    if (!e.empty()) {
+      std::cout << "  envelope (drawn per run):";
+      for (std::size_t k = 0; k < Envelope::kParameters; ++k)
+        if (e.parameter(k).given()) std::cout << " " << Envelope::key(k) << " " << e.parameter(k).text() << ";";
+      std::cout << "  sampling " << enum_name(kEnvelopeSamplingNames, e.sampling) << "\n";
+    }
+    std::cout << std::setprecision(6) << format_summary(stats);
+    if (!e.empty())
+      std::cout << "95 % interval of the mean: |I_r| +- " << std::setprecision(3) << hw * 1e7 << ", I_r,x +- "
+                << hw_x * 1e7 << " [1e-7 kg m] (" << interval_text << ")\n"
+                << std::setprecision(6);
     std::cout << terms_pointer() << "\n";
     if (!a.out.empty())
       std::cout << "wrote " << a.out << "/runs.csv and " << a.out << "/summary.json\n"

@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "abuopt/common/config_sections.hpp"
+#include "abuopt/common/stop.hpp"
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/gnuplot.hpp"
 #include "abuopt/common/plot_style.hpp"
@@ -291,6 +292,7 @@ int run_optimize(const OptimizeArgs& a) {
     return true;
   };
 
+  const StopScope stop_scope;  // SIGINT / SIGTERM end the run after the current evaluation's runs
   opt::OptimizationResult r = run.minimize(progress);
   bar.finish();
   log << "\n" << r.brief_report() << "\n";
@@ -398,14 +400,16 @@ int run_optimize(const OptimizeArgs& a) {
                        {"worse_than_report_profile", verdict.worse}};
     write_json();
   } else if (interrupted) {
-    log << "interrupted: the best design so far is written; rerun the same command to resume from the archive\n";
+    std::cerr << "abuopt: interrupted by " << stop_signal_name() << " after " << r.evaluations
+        << " evaluations: the best design so far is written, every evaluation is in the archive; rerun the same "
+           "command to resume from the archive\n";
   }
 
   log << "wrote " << (out / "history.csv").string() << ", " << result_json.string()
       << (have_best ? ", " + (out / "best_profile.yaml").string() : std::string()) << "\n"
       << convergence_text(plot) << "\n";
   if (a.json) std::cout << j.dump(2) << "\n";
-  if (interrupted) return 130;
+  if (interrupted) return stop_exit_status();
   if (r.reason == opt::TerminationReason::EvaluationError) {
     std::cerr << "abuopt: error: the optimisation ended on an evaluation error: "
               << (r.message.empty() ? std::string("(no message)") : r.message)
@@ -432,7 +436,7 @@ void register_optimize(CLI::App& app) {
       "is archived in OUT/archive.sqlite: rerunning the same command resumes. At the end the best design\n"
       "and the report's final profile are evaluated on a fresh, larger set of initial conditions.\n"
       "Exit status: 0 ok, 2 bad input, 3 no feasible design found or the run ended on an evaluation\n"
-      "error (the reason is printed), 4 an output file could not be written, 130 interrupted (Ctrl-C).");
+      "error (the reason is printed), 4 an output file could not be written, 130 interrupted (Ctrl-C), 143 terminated (SIGTERM).");
   sub->footer("\n" + terms_pointer());
   sub->add_option("config", args->config,
                   "YAML config (abu, profile, motor, simulation, montecarlo, design, objective, constraints,\n"

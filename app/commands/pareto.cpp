@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "abuopt/common/config_sections.hpp"
+#include "abuopt/common/stop.hpp"
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/progress.hpp"
@@ -38,6 +39,7 @@ struct ParetoArgs {
   bool json = false;
   bool progress = false;
   std::optional<long> threads;
+  long max_bounds = 100;  // each bound is a whole optimisation: a total the user asks for explicitly
 };
 
 nlohmann::json evaluation_json(const opt::Evaluation& e) {
@@ -56,6 +58,12 @@ int run_pareto_command(const ParetoArgs& a) {
   const ParetoSettings ps = read_pareto_settings(root.child("pareto"));
   finish_config(root);  // the file may also configure `abuopt optimize` and `abuopt sweep`
   options.validate();
+  if (a.max_bounds < 2) throw ConfigError("--max-bounds", std::to_string(a.max_bounds), "must be >= 2");
+  if (ps.max_startup_time_s.size() > static_cast<std::size_t>(a.max_bounds))
+    throw ConfigError("pareto.max_startup_time_s", std::to_string(ps.max_startup_time_s.size()) + " bounds",
+                      "at most " + std::to_string(a.max_bounds) + " bounds in one run (each is an optimisation of up to " +
+                          std::to_string(options.max_evaluations) +
+                          " evaluations, twice with the warm start); pass --max-bounds N to allow more");
   if (a.threads) {
     if (*a.threads < 0) throw ConfigError("--threads", std::to_string(*a.threads), "must be >= 0 (0 = all cores)");
     settings.threads = static_cast<std::size_t>(*a.threads);
@@ -98,6 +106,7 @@ int run_pareto_command(const ParetoArgs& a) {
     }
     return true;
   };
+  const StopScope stop_scope;  // SIGINT / SIGTERM end the current point's run (abuopt/common/stop.hpp)
   const ParetoResult r = run_pareto(settings, options, ps, (out / "archive.sqlite").string(), a.config,
                                     prov.config_hash, progress, true);
   bar.finish();
@@ -171,7 +180,12 @@ int run_pareto_command(const ParetoArgs& a) {
   write_file_atomic(out / "summary.json", j.dump(2) + "\n");
   log << "wrote " << (out / "pareto.csv").string() << ", " << (out / "summary.json").string() << "\n" << plot << "\n";
   if (a.json) std::cout << j.dump(2) << "\n";
-  if (r.interrupted) return 130;
+  if (r.interrupted) {
+    std::cerr << "abuopt: interrupted by " << stop_signal_name() << ": kept the " << r.points.size()
+        << " points above (pareto.csv, summary.json) and every evaluation in the archive; rerun the same command to "
+           "resume\n";
+    return stop_exit_status();
+  }
   for (const auto& p : r.points)
     if (p.result.feasible) return 0;
   return 3;
@@ -189,9 +203,11 @@ void register_pareto(CLI::App& app) {
       "in OUT/archive.sqlite (a rerun resumes). Then each front point and the 2003 report's profile on\n"
       "fresh initial conditions (out of sample). Writes pareto.csv, summary.json, pareto.png/.pdf.\n"
       "Exit status: 0 ok, 2 bad input, 3 no bound gave a feasible design, 4 a file could not be written,\n"
-      "130 interrupted.");
+      "130 interrupted (Ctrl-C), 143 terminated (SIGTERM).");
   sub->add_option("config", args->config, "YAML config: the sections of `optimize` plus `pareto` (docs/sweep.md)")
       ->required();
+  sub->add_option("--max-bounds", args->max_bounds,
+                  "the most bounds (pareto.max_startup_time_s) one run accepts (default 100; each is an optimisation)");
   sub->add_option("--out", args->out, "output directory (default results/<config stem>)");
   sub->add_flag("--json", args->json, "print summary.json to stdout (progress goes to stderr)");
   sub->add_flag("--progress", args->progress,

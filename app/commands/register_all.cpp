@@ -14,6 +14,9 @@ void register_all(CLI::App& app) {
   register_sweep(app);
   register_pareto(app);
   register_archive(app);
+  register_study(app);
+  // after every option is converted, before the command's callback runs
+  app.parse_complete_callback([&app] { check_option_values(app); });
 }
 
 }  // namespace abuopt::app

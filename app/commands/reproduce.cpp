@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "abuopt/common/stop.hpp"
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/progress.hpp"
@@ -28,6 +29,7 @@ namespace fs = std::filesystem;
 
 struct ReproduceArgs {
   std::optional<long> runs, threads;
+  long long max_total_runs = 10000000;  // the runs of every case together: more is asked for explicitly
   std::vector<std::string> only;
   std::string out, configs;
   bool no_plots = false, progress = false;
@@ -101,6 +103,13 @@ int run_reproduce(const ReproduceArgs& a) {
       runs += c.study.runs;
       all_runs += c.study.runs * (t.contact_variant ? 2 : 1);
     }
+  if (a.max_total_runs < 1) throw ConfigError("--max-total-runs", std::to_string(a.max_total_runs), "must be >= 1");
+  if (all_runs > static_cast<std::size_t>(a.max_total_runs))
+    throw ConfigError(a.runs ? "--runs" : "--only", a.runs ? std::to_string(*a.runs) : std::to_string(tables.size()) + " tables",
+                      "gives " + std::to_string(all_runs) + " runs over " + std::to_string(cases) +
+                          " cases: at most " + std::to_string(a.max_total_runs) +
+                          " in one reproduce (hours of work; a case keeps its runs in memory, about 0.5 kB each); "
+                          "pass --max-total-runs N to allow more");
   ProgressReporter bar("reproduce", "runs", all_runs, a.progress ? ProgressMode::Always : ProgressMode::Auto);
   opt.log = [&bar](const std::string& line) { bar.message(line); };
   opt.progress = [&bar](std::size_t done, std::size_t) { bar.update(done); };
@@ -111,7 +120,16 @@ int run_reproduce(const ReproduceArgs& a) {
   std::cout << "output: " << opt.out_dir << "\n" << std::flush;
 
   const OutputDirLock lock(opt.out_dir);  // one run per output directory
-  const ReproductionReport r = run_reproduction(tables, opt);
+  const StopScope stop_scope;  // SIGINT / SIGTERM stop the current case's runs (abuopt/common/stop.hpp)
+  ReproductionReport r;
+  try {
+    r = run_reproduction(tables, opt);
+  } catch (const Interrupted& e) {
+    bar.finish();
+    throw Interrupted(std::string(e.what()) + "; kept in " + opt.out_dir +
+                      ": the per-case run CSVs and tables.csv of the cases that ended; a rerun computes every case "
+                      "again (the same seeds, the same result)");
+  }
   bar.finish();
 
   std::cout << "\n";
@@ -158,6 +176,8 @@ void register_reproduce(CLI::App& app) {
   sub->add_option("--only", args->only, "comma-separated table ids: 4.1, 4.2, 4.3, 4.4, final, mu (default: all)")
       ->delimiter(',');
   sub->add_option("--threads", args->threads, "worker threads (0 = all cores; results do not depend on it)");
+  sub->add_option("--max-total-runs", args->max_total_runs,
+                  "the most runs of all cases together one reproduce accepts (default 10^7)");
   sub->add_option("--out", args->out, "output directory (default results/reproduce-<timestamp>)");
   sub->add_option("--configs", args->configs, "directory of the study files (default: configs/report)");
   sub->add_flag("--no-plots", args->no_plots, "skip the plots");

@@ -10,6 +10,7 @@
 
 #include "abuopt/common/config_sections.hpp"
 #include "abuopt/common/config_error.hpp"
+#include "abuopt/common/number_text.hpp"
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/text.hpp"
 #include "abuopt/core/monte_carlo.hpp"
@@ -31,18 +32,8 @@ struct SimulateArgs {
 };
 
 std::vector<double> parse_angles(const std::string& text, std::size_t balls) {
-  std::vector<double> out;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    try {
-      size_t used = 0;
-      out.push_back(std::stod(item, &used));
-      if (used != item.size()) throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      throw ConfigError("--beta0", text, "must be a comma-separated list of angles in rad");
-    }
-  }
+  const std::vector<double> out =
+      parse_number_list(text, ',', "--beta0", "must be a comma-separated list of finite angles in rad");
   if (out.size() != balls)
     throw ConfigError("--beta0", text, "must give " + std::to_string(balls) + " angles (one per ball)");
   return out;
@@ -52,7 +43,7 @@ int run_simulate(const SimulateArgs& a) {
   YamlReader root = YamlReader::load_file(a.config);
   SimulationSetup setup = read_simulation_setup(root);
   // A montecarlo section (a config that `abuopt montecarlo` also runs) is checked and not used.
-  if (root.has("montecarlo")) (void)read_monte_carlo_config(root, setup);
+  if (root.has("montecarlo") || root.has("envelope")) (void)read_monte_carlo_config(root, setup);
   finish_config(root);
   if (a.mu) {
     if (!(std::isfinite(*a.mu) && *a.mu >= 0 && *a.mu <= 0.999))
@@ -153,10 +144,11 @@ void register_simulate(CLI::App& app) {
                                      "Exit status: 0 ok, 2 bad input, 3 the simulation failed (status says why).");
   sub->add_option("config", args->config, "YAML config (sections abu, profile, motor, simulation)")->required();
   sub->add_option("--beta0", args->beta0, "initial ball angles in rad, comma-separated (default: evenly spread + 0.3)");
-  sub->add_option("--mu", args->mu, "override the friction coefficient abu.friction_mu")->check(CLI::Range(0.0, 0.999));
+  // no CLI11 validators: their messages ("Value abc not in range ...", a 309-digit bound) are not
+  // ours; run_simulate checks the converted values with the rules of their keys
+  sub->add_option("--mu", args->mu, "override the friction coefficient abu.friction_mu (in [0, 0.999])");
   sub->add_option("--trajectory", args->trajectory, "write the trajectory (t, f, x, y, beta_i, modes) as CSV here");
-  sub->add_option("--trajectory-interval", args->trajectory_interval_s, "trajectory sample interval in s (default 0.01)")
-      ->check(CLI::PositiveNumber);
+  sub->add_option("--trajectory-interval", args->trajectory_interval_s, "trajectory sample interval in s (default 0.01)");
   sub->add_flag("--json", args->json, "print the outcome as one JSON object");
   sub->callback([args] { set_exit_code(run_simulate(*args)); });
 }

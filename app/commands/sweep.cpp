@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "abuopt/common/config_sections.hpp"
+#include "abuopt/common/stop.hpp"
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/provenance.hpp"
@@ -36,26 +37,6 @@ struct SweepArgs {
   std::string out;
   bool json = false;
   std::optional<long> threads;
-};
-
-std::atomic<bool> g_stop{false};
-extern "C" void on_sigint(int) { g_stop.store(true); }
-
-// SIGINT sets g_stop while the sweep runs; the previous handler comes back afterwards.
-class SigintScope {
- public:
-  SigintScope() {
-    struct sigaction sa {};
-    sa.sa_handler = on_sigint;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &previous_);
-  }
-  ~SigintScope() { sigaction(SIGINT, &previous_, nullptr); }
-  SigintScope(const SigintScope&) = delete;
-  SigintScope& operator=(const SigintScope&) = delete;
-
- private:
-  struct sigaction previous_ {};
 };
 
 std::string point_text(const std::vector<opt::Variable>& vars, const std::vector<std::size_t>& swept,
@@ -130,11 +111,10 @@ int run_sweep_command(const SweepArgs& a) {
     log << os.str() << "\n" << std::flush;
   };
 
-  g_stop.store(false);
   SweepResult r;
   {
-    SigintScope sigint;
-    r = run_sweep(problem, archive, plan, progress, &g_stop, options.constraint_tolerance);
+    const StopScope stop_scope;  // SIGINT / SIGTERM stop after the current point (abuopt/common/stop.hpp)
+    r = run_sweep(problem, archive, plan, progress, &stop_flag(), options.constraint_tolerance);
   }
 
   write_sweep_csv(out / "sweep.csv", problem, r);
@@ -191,8 +171,10 @@ int run_sweep_command(const SweepArgs& a) {
   for (const auto& m : plots) log << m << "\n";
   if (a.json) std::cout << j.dump(2) << "\n";
   if (r.interrupted) {
-    log << "interrupted: rerun the same command to evaluate the remaining points (stored ones come from the archive)\n";
-    return 130;
+    std::cerr << "abuopt: interrupted by " << stop_signal_name() << ": kept the " << r.points.size()
+        << " points above (sweep.csv, summary.json, the archive); rerun the same command to evaluate the remaining "
+           "points (stored ones come from the archive)\n";
+    return stop_exit_status();
   }
   return !r.points.empty() && r.failed == static_cast<long>(r.points.size()) ? 3 : 0;
 }
@@ -209,7 +191,7 @@ void register_sweep(CLI::App& app) {
       "(shared with `optimize` on the same config): rerunning resumes. Writes sweep.csv (every point,\n"
       "every metric), summary.json and plots (1 variable: curve with 95 % error bars; 2: maps).\n"
       "Exit status: 0 ok, 2 bad input, 3 every point failed, 4 an output file could not be written,\n"
-      "130 interrupted (Ctrl-C: the points so far are written).");
+      "130 interrupted (Ctrl-C), 143 terminated (SIGTERM): the points so far are written.");
   sub->add_option("config", args->config, "YAML config: the sections of `optimize` plus `sweep` (docs/sweep.md)")
       ->required();
   sub->add_option("--out", args->out, "output directory (default results/<config stem>)");

@@ -6,7 +6,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
+#include <vector>
+#include <sys/stat.h>
 #include <cstdlib>
 #include <sstream>
 
@@ -16,6 +19,7 @@
 namespace abuopt {
 
 namespace {
+constexpr const char* kNullRule = "has no value (null): give a value, or leave the key out for its default";
 std::string fmt(double v) {
   std::ostringstream os;
   os << v;
@@ -119,30 +123,175 @@ void check_unique_keys(const YAML::Node& n, const std::string& path, const std::
   }
 }
 
-// One document per config: a second one (after a `---` line) would be ignored.
-// Parse events are not needed to count documents: this handler ignores them.
-class IgnoreEvents final : public YAML::EventHandler {
+// The shape of a config, checked on the parser's events before any node is built (one pass, one
+// mechanism for every alias, tag and nesting problem; yaml-cpp's nodes share an aliased node, so
+// a walk over them, check_unique_keys or a reader, would expand aliases):
+//  * an alias inside the node it names (`a: &x [*x]`) is a loop: refused (a walk over it never ends);
+//  * the document with every alias expanded has at most kMaxConfigNodes nodes and nests at most
+//    kMaxConfigDepth deep (nested aliases can expand exponentially, "billion laughs");
+//  * no node has an explicit tag (`!foo`, `!!str`): a config is plain data, a tag would be ignored.
+// Only the first document is checked; a second one is an error of its own (single_document).
+class ConfigShape final : public YAML::EventHandler {
  public:
-  void OnDocumentStart(const YAML::Mark&) override {}
+  explicit ConfigShape(std::string what) : what_(std::move(what)) {}
+  void OnDocumentStart(const YAML::Mark&) override { ++documents_; }
   void OnDocumentEnd() override {}
-  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
-  void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
-  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t, const std::string&) override {}
-  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
-  void OnSequenceEnd() override {}
-  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
-  void OnMapEnd() override {}
+  void OnAnchor(const YAML::Mark&, const std::string& name) override { anchor_name_ = name; }
+  void OnNull(const YAML::Mark& m, YAML::anchor_t anchor) override { leaf(m, "", anchor, "~"); }
+  void OnScalar(const YAML::Mark& m, const std::string& tag, YAML::anchor_t anchor, const std::string& v) override {
+    leaf(m, tag, anchor, v);
+  }
+  void OnAlias(const YAML::Mark& m, YAML::anchor_t anchor) override {
+    if (!active()) return;
+    const std::string name = names_.count(anchor) ? "*" + names_[anchor] : std::string("an alias");
+    for (const Frame& f : stack_)
+      if (f.anchor == anchor && anchor != YAML::NullAnchor)
+        fail(m, name, "refers to the node it is part of (a loop): a config cannot contain itself");
+    const auto it = anchors_.find(anchor);
+    const Extent e = it == anchors_.end() ? Extent{1, 0} : it->second;
+    add(m, name, e.nodes, e.height);
+    end_value();
+  }
+  void OnSequenceStart(const YAML::Mark& m, const std::string& tag, YAML::anchor_t anchor,
+                       YAML::EmitterStyle::value) override {
+    open(m, tag, anchor, false);
+  }
+  void OnSequenceEnd() override { close(); }
+  void OnMapStart(const YAML::Mark& m, const std::string& tag, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+    open(m, tag, anchor, true);
+  }
+  void OnMapEnd() override { close(); }
+
+ private:
+  struct Extent {
+    double nodes;        // with every alias expanded
+    std::size_t height;  // levels below the node
+  };
+  struct Frame {
+    YAML::anchor_t anchor = YAML::NullAnchor;
+    bool map = false;
+    bool expect_key = true;
+    std::string key;
+    std::size_t index = 0;
+    double nodes_at_start = 0;
+    std::size_t height = 0;
+  };
+
+  bool active() const { return documents_ == 1; }
+
+  std::string path() const {
+    std::string p;
+    for (const Frame& f : stack_) {
+      if (f.map) {
+        if (f.expect_key) break;  // at a key: the path of its mapping
+        p += (p.empty() ? "" : ".") + f.key;
+      } else {
+        p += "[" + std::to_string(f.index) + "]";
+      }
+    }
+    return p.empty() ? "<top level>" : p;
+  }
+
+  [[noreturn]] void fail(const YAML::Mark& m, const std::string& value, const std::string& rule) const {
+    throw ConfigError(what_ + ", line " + std::to_string(m.line + 1) + ": " + path() + " = " + value + ": " + rule);
+  }
+
+  void check_tag(const YAML::Mark& m, const std::string& tag, const std::string& value) const {
+    if (tag.empty() || tag == "?" || tag == "!") return;
+    fail(m, value, "has the YAML tag '" + tag + "': tags are not used in a config (remove it)");
+  }
+
+  void add(const YAML::Mark& m, const std::string& value, double nodes, std::size_t height) {
+    total_ += nodes;
+    if (total_ > kMaxConfigNodes)
+      fail(m, value,
+           "with its aliases expanded the config has more than " + fmt(kMaxConfigNodes) +
+               " values (the limit of a config): "
+           "write the values out or use fewer nested aliases");
+    if (stack_.size() + height > kMaxConfigDepth)
+      fail(m, value, "nests more than " + std::to_string(kMaxConfigDepth) +
+                         " levels deep (with its aliases expanded; the limit of a config)");
+    if (!stack_.empty()) stack_.back().height = std::max(stack_.back().height, height + 1);
+  }
+
+  // After a node that is a mapping's key or value, or a sequence's element.
+  void end_value() {
+    if (stack_.empty()) return;
+    Frame& f = stack_.back();
+    if (f.map) f.expect_key = !f.expect_key;
+    else ++f.index;
+  }
+
+  void remember(YAML::anchor_t anchor, Extent e) {
+    if (anchor == YAML::NullAnchor) return;
+    anchors_[anchor] = e;
+    if (!anchor_name_.empty()) names_[anchor] = anchor_name_;
+    anchor_name_.clear();
+  }
+
+  void leaf(const YAML::Mark& m, const std::string& tag, YAML::anchor_t anchor, const std::string& value) {
+    if (!active()) return;
+    if (!stack_.empty() && stack_.back().map && stack_.back().expect_key) stack_.back().key = value;
+    check_tag(m, tag, value);
+    add(m, value, 1, 0);
+    remember(anchor, {1, 0});
+    end_value();
+  }
+
+  void open(const YAML::Mark& m, const std::string& tag, YAML::anchor_t anchor, bool map) {
+    if (!active()) return;
+    if (!stack_.empty() && stack_.back().map && stack_.back().expect_key) stack_.back().key = "<key>";
+    check_tag(m, tag, map ? "{...}" : "[...]");
+    add(m, map ? "{...}" : "[...]", 1, 0);
+    if (anchor != YAML::NullAnchor && !anchor_name_.empty()) {
+      names_[anchor] = anchor_name_;
+      anchor_name_.clear();
+    }
+    Frame f;
+    f.anchor = anchor;
+    f.map = map;
+    f.nodes_at_start = total_ - 1;
+    stack_.push_back(f);
+  }
+
+  void close() {
+    if (!active() || stack_.empty()) return;
+    const Frame f = stack_.back();
+    stack_.pop_back();
+    if (!stack_.empty()) stack_.back().height = std::max(stack_.back().height, f.height + 1);
+    remember(f.anchor, {total_ - f.nodes_at_start, f.height});
+    end_value();
+  }
+
+  std::string what_;
+  int documents_ = 0;
+  double total_ = 0;
+  std::vector<Frame> stack_;
+  std::map<YAML::anchor_t, Extent> anchors_;
+  std::map<YAML::anchor_t, std::string> names_;
+  std::string anchor_name_;
 };
+
+// YAML 1.2 counts a lone CR as a line break; yaml-cpp does not (a file saved with CR-only line
+// endings would read as one line, or as empty). Lone CRs become LF; CRLF stays.
+std::string normalise_line_breaks(const std::string& text) {
+  if (text.find('\r') == std::string::npos) return text;
+  std::string out = text;
+  for (std::size_t i = 0; i < out.size(); ++i)
+    if (out[i] == '\r' && (i + 1 == out.size() || out[i + 1] != '\n')) out[i] = '\n';
+  return out;
+}
 
 // The first YAML document of `text`; a second one is an error. yaml-cpp's LoadAll is not used: on
 // some malformed input (found by fuzz_config) its parser keeps reporting empty documents, and
 // LoadAll collects them until memory runs out. Asking the parser for two documents at most cannot
-// loop. (A config is small: parsing it twice costs nothing that matters.)
-YAML::Node single_document(const std::string& text, const std::string& what) {
+// loop. The first pass also checks the document's shape (ConfigShape) before it is built.
+YAML::Node single_document(const std::string& raw, const std::string& what) {
+  const std::string text = normalise_line_breaks(raw);
   std::istringstream count_in(text);
   YAML::Parser parser(count_in);
-  IgnoreEvents ignore;
-  if (parser.HandleNextDocument(ignore) && parser.HandleNextDocument(ignore))
+  ConfigShape shape(what);
+  if (parser.HandleNextDocument(shape) && parser.HandleNextDocument(shape))
     throw ConfigError(what + " holds more than one YAML document (a line '---' starts a new one): a config "
                              "is one document");
   return YAML::Load(text);
@@ -151,9 +300,17 @@ YAML::Node single_document(const std::string& text, const std::string& what) {
 }  // namespace
 
 YamlReader YamlReader::load_file(const std::string& file) {
+  // a name with a NUL (possible from Python) would be cut there by every system call
+  if (file.find('\0') != std::string::npos)
+    throw ConfigError("config file name '" + file.substr(0, file.find('\0')) +
+                      "<NUL>...' contains a NUL character: not a file name");
   std::error_code ec;
   if (std::filesystem::is_directory(file, ec))
     throw ConfigError("config file '" + file + "' is a directory, not a YAML file");
+  // A FIFO, socket or device would block the read or never end: a config is a regular file.
+  struct stat st {};
+  if (::stat(file.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+    throw ConfigError("config file '" + file + "' is not a regular file (a FIFO, device or socket): give a YAML file");
   YAML::Node n;
   try {
     std::ifstream in(file, std::ios::binary);
@@ -187,7 +344,7 @@ std::string YamlReader::key_path(const std::string& key) const { return path_.em
 bool YamlReader::has(const std::string& key) const {
   if (!present()) return false;
   const YAML::Node n = node_[key];
-  return n && !n.IsNull();
+  return static_cast<bool>(n);  // a null value is given too: reading it is an error (at)
 }
 
 YAML::Node YamlReader::at(const std::string& key) {
@@ -197,7 +354,10 @@ YAML::Node YamlReader::at(const std::string& key) {
   if (!present()) return YAML::Node(YAML::NodeType::Undefined);
   const YAML::Node& cnode = node_;  // const access: the non-const operator[] would insert the key
   YAML::Node n = cnode[key];
-  if (!n || n.IsNull()) return YAML::Node(YAML::NodeType::Undefined);
+  if (!n) return YAML::Node(YAML::NodeType::Undefined);
+  // `key: ~`, `key: null` or `key:` with nothing: not a value, and not the default either (that
+  // would take the default without a word)
+  if (n.IsNull()) throw ConfigError(key_path(key), "~", kNullRule);
   return n;
 }
 
@@ -337,7 +497,10 @@ std::vector<YamlReader> YamlReader::children(const std::string& key) {
   std::vector<YamlReader> out;
   if (!n) return out;
   if (!n.IsSequence()) throw ConfigError(key_path(key), yaml_value_text(n), "must be a list");
-  for (size_t i = 0; i < n.size(); ++i) out.emplace_back(n[i], key_path(key) + "[" + std::to_string(i) + "]");
+  for (size_t i = 0; i < n.size(); ++i) {
+    if (n[i].IsNull()) throw ConfigError(key_path(key) + "[" + std::to_string(i) + "]", "~", kNullRule);
+    out.emplace_back(n[i], key_path(key) + "[" + std::to_string(i) + "]");
+  }
   return out;
 }
 

@@ -1,5 +1,7 @@
 #include "abuopt/core/batch_runner.hpp"
 
+#include "abuopt/common/stop.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -34,8 +36,15 @@ void ThreadPoolRunner::run(std::size_t count, const std::function<void(std::size
   std::size_t done = 0;
   std::exception_ptr first_error;
 
+  std::atomic<bool> interrupted{false};
   auto worker = [&] {
     while (!stop.load(std::memory_order_relaxed)) {
+      // the stop request (SIGINT / SIGTERM, abuopt/common/stop.hpp): no new task; those running finish
+      if (stop_requested()) {
+        interrupted.store(true);
+        stop.store(true, std::memory_order_relaxed);
+        return;
+      }
       const std::size_t i = next.fetch_add(1, std::memory_order_relaxed);
       if (i >= count) return;
       try {
@@ -43,6 +52,10 @@ void ThreadPoolRunner::run(std::size_t count, const std::function<void(std::size
         std::lock_guard<std::mutex> lock(mutex);
         ++done;
         if (progress && !first_error) progress(done, count, elapsed());  // may throw to cancel
+      } catch (const Interrupted&) {  // a run that polled the stop request itself (simulator.cpp)
+        interrupted.store(true);
+        stop.store(true, std::memory_order_relaxed);
+        return;
       } catch (...) {
         std::lock_guard<std::mutex> lock(mutex);
         if (!first_error) first_error = std::current_exception();
@@ -73,6 +86,9 @@ void ThreadPoolRunner::run(std::size_t count, const std::function<void(std::size
     for (auto& t : pool) t.join();
   }
   if (first_error) std::rethrow_exception(first_error);
+  if (interrupted.load() && done < count)
+    throw Interrupted("interrupted by " + stop_signal_name() + " after " + std::to_string(done) + " of " +
+                      std::to_string(count) + " runs");
 }
 
 }  // namespace abuopt

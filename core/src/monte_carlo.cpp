@@ -6,6 +6,7 @@
 #include <map>
 #include <numeric>
 
+#include "abuopt/common/stop.hpp"
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/core/ball_contact.hpp"
 
@@ -16,6 +17,10 @@ namespace {
 MonteCarloSample make_sample(const MonteCarloStudy& s, std::size_t index, std::vector<double> beta0) {
   MonteCarloSample out;
   out.index = index;
+  if (joint_sampling(s)) {  // the start angles from the joint scrambled Sobol' point
+    for (std::size_t b = 0; b < beta0.size(); ++b)
+      beta0[b] = 2.0 * M_PI * joint_sobol_coordinate(s.seed, index, Envelope::kParameters + b);
+  }
   // With hard ball contact every design point is mapped onto the feasible set (no overlapping
   // start; docs/model.md 11.6): a deterministic map, so a run stays replayable from (seed, index).
   out.beta0 = s.setup.abu.ball_contact == BallContact::Hard && beta0.size() >= 2
@@ -25,6 +30,8 @@ MonteCarloSample make_sample(const MonteCarloStudy& s, std::size_t index, std::v
   out.friction_mu = out.overrides.friction_mu.value_or(s.setup.abu.friction_mu);
   out.imbalance_kgm =
       out.overrides.imbalance_mass_kg.value_or(s.setup.abu.imbalance_mass_kg) * s.setup.abu.eccentricity_m;
+  out.stiffness_N_per_m = out.overrides.stiffness_N_per_m.value_or(s.setup.abu.stiffness_N_per_m);
+  out.restitution = out.overrides.ball_restitution.value_or(s.setup.abu.ball_restitution);
   return out;
 }
 
@@ -36,6 +43,8 @@ std::vector<double> exchange_key(const MonteCarloSample& smp) {
   k.push_back(smp.friction_mu);
   k.push_back(smp.imbalance_kgm);
   k.push_back(smp.overrides.imbalance_angle_rad);
+  k.push_back(smp.stiffness_N_per_m);
+  k.push_back(smp.restitution);
   return k;
 }
 
@@ -73,6 +82,12 @@ RunOutcome permuted_outcome(const MonteCarloSample& from, const MonteCarloSample
 
 }  // namespace
 
+bool joint_sampling(const MonteCarloStudy& s) {
+  const Envelope& e = s.uncertain.envelope;
+  return e.sampling == EnvelopeSampling::Sobol && !e.deterministic() &&
+         (s.design.kind == InitialConditionKind::Random || s.design.kind == InitialConditionKind::Sobol);
+}
+
 bool balls_exchangeable(const SimulationSetup& setup) {
   const auto& b = setup.abu.balls;
   for (const auto& x : b)
@@ -105,6 +120,13 @@ void validate(const MonteCarloStudy& s, const std::string& path) {
                           std::to_string(d.balls) + " = " + std::to_string(d.size()) +
                           " with the grid design (change grid, or use design random, lhs, halton or sobol)");
   validate(s.uncertain, path);
+  if (joint_sampling(s) && s.setup.abu.balls.size() > Envelope::kMaxJointBalls)
+    throw ConfigError("envelope.sampling", "sobol",
+                      "draws the start angles of at most 6 balls (the Sobol' directions cover 10 dimensions); "
+                      "use sampling: random, or a montecarlo.design other than random/sobol");
+  if (s.uncertain.envelope.restitution.given() && s.setup.abu.ball_contact != BallContact::Hard)
+    throw ConfigError("envelope.restitution", s.uncertain.envelope.restitution.text(),
+                      "needs abu.ball_contact: hard (restitution is the ball-ball impacts' coefficient)");
 }
 
 MonteCarloSample prepare_sample(const MonteCarloStudy& s, std::size_t index) {
@@ -142,10 +164,16 @@ MonteCarloSample run_one(const MonteCarloStudy& s, std::size_t index, const Samp
 PreparedStudy prepare_study(const MonteCarloStudy& s) {
   validate(s);
   std::vector<std::vector<double>> points = generate_initial_conditions(study_design(s));
+  throw_if_stop_requested();  // a study of 10^6 runs takes seconds to prepare: the stop request ends it too
   PreparedStudy p;
   p.samples.resize(s.runs);
-  for (std::size_t i = 0; i < s.runs; ++i) p.samples[i] = make_sample(s, i, std::move(points[i]));
+  for (std::size_t i = 0; i < s.runs; ++i) {
+    if ((i & 4095) == 0) throw_if_stop_requested();
+    p.samples[i] = make_sample(s, i, std::move(points[i]));
+  }
+  throw_if_stop_requested();
   const std::vector<std::size_t> same = reuse_map(s, p.samples);
+  throw_if_stop_requested();
   for (std::size_t i = 0; i < s.runs; ++i) {
     p.samples[i].reused = same[i] != i;
     p.samples[i].reused_from = same[i];
@@ -231,12 +259,15 @@ MonteCarloConfig read_section(YamlReader& mc, SimulationSetup setup) {
 
 MonteCarloConfig read_monte_carlo_config_unchecked(YamlReader& root, SimulationSetup setup) {
   YamlReader mc = root.child("montecarlo");
-  return read_section(mc, std::move(setup));
+  MonteCarloConfig cfg = read_section(mc, std::move(setup));
+  cfg.study.uncertain.envelope = read_envelope(root);
+  return cfg;
 }
 
 MonteCarloConfig read_monte_carlo_config(YamlReader& root, SimulationSetup setup) {
   YamlReader mc = root.child("montecarlo");
   MonteCarloConfig cfg = read_section(mc, std::move(setup));
+  cfg.study.uncertain.envelope = read_envelope(root);
   validate(cfg.study, mc.path());
   return cfg;
 }

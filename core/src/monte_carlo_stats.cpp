@@ -263,12 +263,56 @@ std::string format_summary(const MonteCarloStats& s) {
   return os.str();
 }
 
+IntervalLayout interval_layout(const MonteCarloStudy& s) {
+  if (joint_sampling(s)) return {IntervalKind::Replicates, Envelope::kReplicates};
+  const std::size_t h = s.uncertain.envelope.deterministic() ? 1 : s.uncertain.envelope.strata();
+  if (h > 1) return {IntervalKind::Strata, h};
+  return {};
+}
+
+double mean_half_width95(const std::vector<MonteCarloSample>& samples, const IntervalLayout& layout, bool report_x) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::size_t g = layout.kind == IntervalKind::Independent ? 1 : std::max<std::size_t>(layout.groups, 1);
+  // per group: count, mean and sum of squares (Welford)
+  std::vector<double> n(g, 0.0), mean(g, 0.0), m2(g, 0.0);
+  for (const auto& s : samples) {
+    if (!s.outcome.ok()) continue;
+    const double x = report_x ? s.outcome.residual_imbalance_x_kgm : s.outcome.residual_imbalance_kgm;
+    const std::size_t k = s.index % g;
+    n[k] += 1;
+    const double d = x - mean[k];
+    mean[k] += d / n[k];
+    m2[k] += d * (x - mean[k]);
+  }
+  if (layout.kind != IntervalKind::Replicates) {
+    double var = 0;  // of the (stratified) mean, equal weights 1/g
+    for (std::size_t k = 0; k < g; ++k) {
+      if (n[k] < 2) return nan;
+      var += m2[k] / (n[k] - 1) / n[k] / static_cast<double>(g * g);
+    }
+    return 1.96 * std::sqrt(var);
+  }
+  std::vector<double> means;
+  for (std::size_t k = 0; k < g; ++k)
+    if (n[k] > 0) means.push_back(mean[k]);
+  if (means.size() < 2) return nan;
+  double m = 0, var = 0;
+  for (double x : means) m += x;
+  m /= static_cast<double>(means.size());
+  for (double x : means) var += (x - m) * (x - m);
+  var /= static_cast<double>(means.size() - 1);
+  // t quantile 0.975 with nu degrees of freedom (Cornish-Fisher; 2.131 for nu = 15, within 1e-3)
+  const double nu = static_cast<double>(means.size() - 1), z = 1.959964;
+  const double t = z + (z * z * z + z) / (4 * nu) + (5 * std::pow(z, 5) + 16 * z * z * z + 3 * z) / (96 * nu * nu);
+  return t * std::sqrt(var / static_cast<double>(means.size()));
+}
+
 void write_runs_csv(std::ostream& os, const std::vector<MonteCarloSample>& samples) {
   std::size_t n = 0;
   for (const auto& s : samples) n = std::max({n, s.beta0.size(), s.outcome.beta_final.size()});
   os << "index";
   for (std::size_t j = 1; j <= n; ++j) os << ",beta0_" << j;
-  os << ",mu,imbalance_mass_kg,imbalance_angle_rad";
+  os << ",mu,imbalance_mass_kg,imbalance_angle_rad,stiffness_N_per_m,restitution";
   for (std::size_t j = 1; j <= n; ++j) os << ",beta_final_" << j;
   os << ",ir_magnitude_kgm,ir_x_kgm,settled,settling_time_s,max_amplitude_mm,events,rhs_evaluations,status\n";
   for (const auto& s : samples) {
@@ -277,7 +321,7 @@ void write_runs_csv(std::ostream& os, const std::vector<MonteCarloSample>& sampl
     for (std::size_t j = 0; j < n; ++j) os << ',' << (j < s.beta0.size() ? num(s.beta0[j]) : "");
     os << ',' << num(s.friction_mu) << ','
        << (s.overrides.imbalance_mass_kg ? num(*s.overrides.imbalance_mass_kg) : std::string()) << ','
-       << num(s.overrides.imbalance_angle_rad);
+       << num(s.overrides.imbalance_angle_rad) << ',' << num(s.stiffness_N_per_m) << ',' << num(s.restitution);
     for (std::size_t j = 0; j < n; ++j) os << ',' << (j < o.beta_final.size() ? num(o.beta_final[j]) : "");
     os << ',' << num(o.residual_imbalance_kgm) << ',' << num(o.residual_imbalance_x_kgm) << ','
        << (o.settled ? 1 : 0) << ',' << num(o.settling_time_s) << ',' << num(o.max_amplitude_mm) << ',' << o.events

@@ -38,6 +38,8 @@
 #include "abuopt/core/simulation_config.hpp"
 #include "integrator.hpp"
 #include "sim_run_state.hpp"
+#include "run_forcing_table.hpp"
+#include "abuopt/common/stop.hpp"
 #include "stuck_propagator.hpp"
 
 namespace abuopt {
@@ -71,8 +73,13 @@ Simulator::Simulator(SimulationSetup setup) : setup_(std::move(setup)) {
   // table, so they are computed once here and shared by every run.
   const NondimParameters nd = NondimParameters::from(setup_.abu);
   if (o.stuck_integrator == StuckIntegrator::Exact && o.method == FrictionMethod::EventDriven &&
-      setup_.motor.kind == MotorKind::Ideal && StuckForcingTable::supports(nd))
-    stuck_table_ = StuckForcingTable::shared(setup_.profile, nd, end_time_s() * nd.omega_n);
+      setup_.motor.kind == MotorKind::Ideal && StuckForcingTable::supports(nd)) {
+    try {
+      stuck_table_ = StuckForcingTable::shared(setup_.profile, nd, end_time_s() * nd.omega_n);
+    } catch (const std::invalid_argument&) {
+      // a profile too long for a stored table (kMaxStoredIntervals): the Runge-Kutta path, in bounded memory
+    }
+  }
   if (setup_.motor.kind == MotorKind::PI && setup_.motor.feedforward.enabled)
     reference_ = std::make_shared<const StartupProfile>(feedforward_setpoint(setup_.profile, setup_.motor));
 }
@@ -134,10 +141,18 @@ class Run {
       contact_setup(rs_, y_.data());
     }
     choose_initial_modes();
-    // The exact stuck-phase propagator needs the table of this run's omega_n and bbar (an
-    // imbalance-mass override changes both: such runs keep the Runge-Kutta path) and no trajectory.
-    if (stuck_table && !rs_.pi_motor && event_driven_ && !(trajectory_ && traj_dt_ > 0) && stuck_table->matches(rs_.nd))
+    // The exact stuck-phase propagator (ideal motor, event-driven, no trajectory): the Simulator's
+    // table when this run has its omega_n and bbar, else (an uncertain stiffness or imbalance
+    // mass) a view of the shared profile samples formed for this run (run_forcing_table.hpp).
+    const bool exact = rs_.opt.stuck_integrator == StuckIntegrator::Exact && !rs_.pi_motor && event_driven_ &&
+                       !(trajectory_ && traj_dt_ > 0);
+    if (exact && stuck_table && stuck_table->matches(rs_.nd)) {
       stuck_.emplace(*stuck_table, rs_, rs_.contact ? roots_contact : roots_plain);
+    } else if (exact && StuckForcingTable::supports(rs_.nd)) {
+      run_table_.emplace(
+          ForcingSamples::shared(setup_.profile, RunForcingTable::damped_frequency(rs_.nd), end_time_s), rs_.nd);
+      stuck_run_.emplace(*run_table_, rs_, rs_.contact ? roots_contact : roots_plain);
+    }
   }
 
   RunOutcome execute();
@@ -146,6 +161,8 @@ class Run {
   static AbuParameters with_overrides(AbuParameters p, const RunOverrides& ov) {
     if (ov.friction_mu) p.friction_mu = *ov.friction_mu;
     if (ov.imbalance_mass_kg) p.imbalance_mass_kg = *ov.imbalance_mass_kg;
+    if (ov.stiffness_N_per_m) p.stiffness_N_per_m = *ov.stiffness_N_per_m;
+    if (ov.ball_restitution) p.ball_restitution = *ov.ball_restitution;
     return p;
   }
   void choose_initial_modes();
@@ -184,6 +201,12 @@ class Run {
   std::deque<double> recent_events_;
   std::vector<double> ref_steps_;  // step times of the quantised reference (tbar), sorted
   std::optional<StuckPropagator> stuck_;
+  std::optional<RunForcingTable> run_table_;
+  std::optional<RunStuckPropagator> stuck_run_;
+  bool exact_stuck() const { return stuck_ || stuck_run_; }
+  StuckPropagatorResult::Result advance_stuck(double& t, std::vector<double>& y, double stop) {
+    return stuck_ ? stuck_->advance(t, y, stop, rinfo_, peak_amp_) : stuck_run_->advance(t, y, stop, rinfo_, peak_amp_);
+  }
 };
 
 void Run::hold_reference_after(double tbar) {
@@ -360,14 +383,19 @@ RunOutcome Run::execute() {
 
   const bool tail_enabled = event_driven_ && rs_.opt.closed_form_tail && !tracing;
   bool integ_stale = false;  // the exact propagator moved (t, y): the stepper restarts from there
+  unsigned long passes = 0;
   while (t < t_end_) {
+    // the stop request (SIGINT / SIGTERM, common/stop.hpp): a run can take seconds (chatter, a
+    // long end time), so it ends here too, not only between runs; the batch runner then reports
+    // the interruption and no outcome of this run is kept
+    if ((++passes & 255u) == 0 && stop_requested()) throw Interrupted("interrupted by " + stop_signal_name());
     Integrator::Result res = Integrator::Ok;
-    if (stuck_ && rs_.frozen) {
+    if (exact_stuck() && rs_.frozen) {
       // every ball stuck: the exact propagator, to the next stop time (a breakpoint, the end, or
       // the next attempt of the closed-form tail) or the next stick -> slip root
       double stop = next_break < breaks.size() ? breaks[next_break] : t_end_;
       if (tail_enabled && t >= t_profile_ && next_tail_check > t) stop = std::min(stop, next_tail_check);
-      const StuckPropagator::Result r = stuck_->advance(t, y, stop, rinfo_, peak_amp_);
+      const StuckPropagator::Result r = advance_stuck(t, y, stop);
       if (r == StuckPropagator::NotFinite) {
         out_.status = RunStatus::SolverFailure;
         out_.message = "state not finite (exact stuck-phase propagator) at t = " + std::to_string(t / w_) + " s";
@@ -438,7 +466,7 @@ RunOutcome Run::execute() {
 }
 
 RunOutcome Run::finish(const Integrator& integ) {
-  out_.steps = integ.steps() + (stuck_ ? stuck_->intervals() : 0);
+  out_.steps = integ.steps() + (stuck_ ? stuck_->intervals() : 0) + (stuck_run_ ? stuck_run_->intervals() : 0);
   out_.rhs_evaluations = rs_.rhs_evals;
   out_.max_amplitude_mm = peak_amp_;
   for (std::size_t i = 0; i < rs_.n; ++i) out_.beta_final.push_back(wrap_angle(y_[lay_.beta(i)]));
@@ -460,6 +488,11 @@ RunOutcome Simulator::run(const std::vector<double>& beta0, const RunOverrides& 
   if (beta0.size() != setup_.abu.balls.size())  // API misuse: the caller sizes beta0 from ball_count()
     throw std::invalid_argument("Simulator::run: the ABU has " + std::to_string(setup_.abu.balls.size()) +
                                 " balls, but " + std::to_string(beta0.size()) + " initial angles were given");
+  if ((ov.stiffness_N_per_m && !(*ov.stiffness_N_per_m > 0 && std::isfinite(*ov.stiffness_N_per_m))) ||
+      (ov.imbalance_mass_kg && !(*ov.imbalance_mass_kg > 0 && std::isfinite(*ov.imbalance_mass_kg))) ||
+      (ov.ball_restitution && !(*ov.ball_restitution >= 0 && *ov.ball_restitution <= 1)))
+    throw std::invalid_argument("Simulator::run: an override is out of range (stiffness and imbalance mass > 0, "
+                                "restitution in [0, 1])");
   Run run(setup_, end_time_s(), beta0, ov, trajectory, stuck_table_.get(), reference_ ? *reference_ : setup_.profile);
   RunOutcome out = run.execute();
   out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

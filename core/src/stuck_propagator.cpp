@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "root_refine.hpp"
+#include "run_forcing_table.hpp"
 
 namespace abuopt::detail {
 
@@ -16,6 +17,9 @@ namespace {
 
 constexpr int kNodes = 7;               // Gauss-Legendre nodes per interval
 constexpr double kCheckFraction = 0.5;  // grid spacing / period of the fastest margin oscillation
+
+
+}  // namespace
 
 // Gauss-Legendre nodes and weights on [0, 1] (Newton on the Legendre polynomial).
 void gauss_legendre(int m, std::vector<double>& x, std::vector<double>& w) {
@@ -49,7 +53,6 @@ void gauss_legendre(int m, std::vector<double>& x, std::vector<double>& w) {
   }
 }
 
-}  // namespace
 
 bool StuckForcingTable::supports(const NondimParameters& nd) {
   return nd.bbar > 0 && std::fabs(nd.bbar - 1.0) > 1e-6 && std::isfinite(nd.bbar) && nd.omega_n > 0;
@@ -70,6 +73,7 @@ StuckForcingTable::StuckForcingTable(const StartupProfile& profile, const Nondim
   struct Piece {
     double a, b, Wmax;
     bool constant;
+    bool tail = false;  // the constant speed after the profile: not stored
   };
   std::vector<Piece> pieces;
   const double to_W = 2.0 * M_PI / omega_n_;
@@ -82,13 +86,16 @@ StuckForcingTable::StuckForcingTable(const StartupProfile& profile, const Nondim
     pieces.push_back({a, b, to_W * std::max(f0, f1), f0 == f1});
   }
   const double tp = profile_.duration_s() * omega_n_;
-  if (t_end_bar > tp) pieces.push_back({tp, t_end_bar, to_W * profile_.final_frequency_hz(), true});
+  if (t_end_bar > tp) pieces.push_back({tp, t_end_bar, to_W * profile_.final_frequency_hz(), true, true});
 
   // every vector's final size first: no reallocation while filling (the table is ~100 B per
   // interval, ~17k intervals for the final profile)
-  std::size_t total = 1;
+  double stored = 1;
   for (const Piece& pc : pieces)
-    total += static_cast<std::size_t>(std::max(1.0, std::ceil((pc.b - pc.a) / (kCheckFraction * 2.0 * M_PI / (pc.Wmax + wd)))));
+    if (!pc.tail) stored += std::max(1.0, std::ceil((pc.b - pc.a) / (kCheckFraction * 2.0 * M_PI / (pc.Wmax + wd))));
+  if (!(stored <= static_cast<double>(kMaxStoredIntervals)))
+    throw std::invalid_argument("StuckForcingTable: the profile needs more than kMaxStoredIntervals intervals");
+  const auto total = static_cast<std::size_t>(stored);
   t_.reserve(total);
   W_.reserve(total);
   Wp_.reserve(total);
@@ -126,6 +133,32 @@ StuckForcingTable::StuckForcingTable(const StartupProfile& profile, const Nondim
     double W0, Wp0;
     cplx e0;
     sample(pc.a, W0, Wp0, e0);
+    if (pc.tail) {  // kept as its closed form (the same values the loop below would store)
+      tail_n_ = static_cast<std::size_t>(n);
+      tail_a_ = pc.a;
+      tail_h_ = h;
+      tail_W_ = pc.Wmax;
+      tail_e0_ = e0;
+      for (int k = 0; k < 2; ++k) {
+        tail_E_[k] = E[k];
+        tail_Fc_[k] = Fc[k];
+      }
+      const double t0 = pc.a + static_cast<double>(n - 1) * h;
+      if (pc.b - t0 != h) {
+        partial(t0, pc.b - t0, tail_last_P_);
+        for (int k = 0; k < 2; ++k) tail_last_E_[k] = std::exp(lam_[k] * (pc.b - t0));
+      } else {
+        const cplx e = e0 * std::polar(1.0, pc.Wmax * (t0 - pc.a));
+        for (int k = 0; k < 2; ++k) {
+          tail_last_P_[k] = Fc[k] * e;
+          tail_last_E_[k] = E[k];
+        }
+      }
+      cplx e;
+      sample(pc.b, tail_end_W_, tail_end_Wp_, e);
+      tail_end_rot_ = std::conj(e);
+      continue;
+    }
     for (long j = 0; j < n; ++j) {
       const double t0 = pc.a + static_cast<double>(j) * h;
       const double t1 = j + 1 == n ? pc.b : pc.a + static_cast<double>(j + 1) * h;
@@ -165,7 +198,50 @@ StuckForcingTable::StuckForcingTable(const StartupProfile& profile, const Nondim
       }
     }
   }
-  if (t_.size() < 2) throw std::invalid_argument("StuckForcingTable: empty time span");
+  if (intervals() < 1) throw std::invalid_argument("StuckForcingTable: empty time span");
+}
+
+double StuckForcingTable::t(std::size_t j) const {
+  const std::size_t s = t_.size() - 1;
+  if (j <= s) return t_[j];
+  const std::size_t i = j - s;
+  return i >= tail_n_ ? t_end_bar_ : tail_a_ + static_cast<double>(i) * tail_h_;
+}
+
+cplx StuckForcingTable::decay(int k, std::size_t j) const {
+  const std::size_t s = t_.size() - 1;
+  if (j < s) return E_[2 * j + static_cast<std::size_t>(k)];
+  return j - s + 1 == tail_n_ ? tail_last_E_[k] : tail_E_[k];
+}
+
+cplx StuckForcingTable::forcing(int k, std::size_t j) const {
+  const std::size_t s = t_.size() - 1;
+  if (j < s) return P_[2 * j + static_cast<std::size_t>(k)];
+  const std::size_t i = j - s;
+  if (i + 1 == tail_n_) return tail_last_P_[k];
+  const double t0 = tail_a_ + static_cast<double>(i) * tail_h_;
+  return tail_Fc_[k] * (tail_e0_ * std::polar(1.0, tail_W_ * (t0 - tail_a_)));
+}
+
+cplx StuckForcingTable::unrotate(std::size_t j) const {
+  const std::size_t s = t_.size() - 1;
+  if (j <= s) return rot_[j];
+  const std::size_t i = j - s;
+  if (i >= tail_n_) return tail_end_rot_;
+  const double t1 = tail_a_ + static_cast<double>(i) * tail_h_;
+  return std::conj(tail_e0_ * std::polar(1.0, tail_W_ * (t1 - tail_a_)));
+}
+
+double StuckForcingTable::speed(std::size_t j) const {
+  const std::size_t s = t_.size() - 1;
+  if (j <= s) return W_[j];
+  return j - s >= tail_n_ ? tail_end_W_ : tail_W_;
+}
+
+double StuckForcingTable::speed_rate(std::size_t j) const {
+  const std::size_t s = t_.size() - 1;
+  if (j <= s) return Wp_[j];
+  return j - s >= tail_n_ ? tail_end_Wp_ : 0.0;
 }
 
 bool StuckForcingTable::same(const StartupProfile& profile, const NondimParameters& nd, double t_end_bar) const {
@@ -207,6 +283,14 @@ std::shared_ptr<const StuckForcingTable> StuckForcingTable::shared(const Startup
 }
 
 std::size_t StuckForcingTable::interval(double tbar) const {
+  const std::size_t s = t_.size() - 1;
+  if (tail_n_ > 0 && tbar >= t_[s]) {
+    const double q = (tbar - tail_a_) / tail_h_;
+    std::size_t i = q <= 0 ? 0 : q >= static_cast<double>(tail_n_ - 1) ? tail_n_ - 1 : static_cast<std::size_t>(q);
+    while (i + 1 < tail_n_ && t(s + i + 1) <= tbar) ++i;
+    while (i > 0 && t(s + i) > tbar) --i;
+    return s + i;
+  }
   const auto it = std::upper_bound(t_.begin(), t_.end(), tbar);
   const std::size_t j = it == t_.begin() ? 0 : static_cast<std::size_t>(it - t_.begin()) - 1;
   return std::min(j, intervals() - 1);
@@ -234,7 +318,8 @@ void StuckForcingTable::partial(double t0, double h, cplx P[2]) const {
   }
 }
 
-StuckPropagator::StuckPropagator(const StuckForcingTable& tab, RunState& rs, RootFn g)
+template <class Table>
+StuckPropagatorT<Table>::StuckPropagatorT(const Table& tab, RunState& rs, RootFn g)
     : tab_(tab), rs_(rs), g_(g) {
   ywork_.resize(rs.lay().size());
   g0_.resize(rs.nroots());
@@ -243,7 +328,8 @@ StuckPropagator::StuckPropagator(const StuckForcingTable& tab, RunState& rs, Roo
   L_mm_ = rs.params.ball_track_radius_m * 1e3;
 }
 
-void StuckPropagator::to_modal(double t, const double* y) {
+template <class Table>
+void StuckPropagatorT<Table>::to_modal(double t, const double* y) {
   double W, Wp;
   cplx e;
   tab_.sample(t, W, Wp, e);
@@ -256,7 +342,8 @@ void StuckPropagator::to_modal(double t, const double* y) {
   a_[1] = r * (l1 * Z - Zd);
 }
 
-void StuckPropagator::from_modal(const cplx a[2], double W, const cplx& rot, double* y) const {
+template <class Table>
+void StuckPropagatorT<Table>::from_modal(const cplx a[2], double W, const cplx& rot, double* y) const {
   const cplx Z = a[0] + a[1], Zd = tab_.lambda(0) * a[0] + tab_.lambda(1) * a[1];
   const cplx z = Z * rot, zd = Zd * rot - cplx(0, W) * z;
   y[StateLayout::x] = z.real();
@@ -265,7 +352,8 @@ void StuckPropagator::from_modal(const cplx a[2], double W, const cplx& rot, dou
   y[StateLayout::y_dot] = zd.imag();
 }
 
-void StuckPropagator::state_at(double t0, const cplx a0[2], double t, double* y) const {
+template <class Table>
+void StuckPropagatorT<Table>::state_at(double t0, const cplx a0[2], double t, double* y) const {
   cplx P[2];
   tab_.partial(t0, t - t0, P);
   cplx a[2];
@@ -277,7 +365,8 @@ void StuckPropagator::state_at(double t0, const cplx a0[2], double t, double* y)
 }
 
 // Illinois on the exact solution (the stepper's polished roots, docs/model.md 11.5).
-double StuckPropagator::locate(std::size_t k, double ta, double ga, double tb, double gb, const cplx a0[2], double t0) {
+template <class Table>
+double StuckPropagatorT<Table>::locate(std::size_t k, double ta, double ga, double tb, double gb, const cplx a0[2], double t0) {
   std::vector<double> yc(ywork_);
   auto g = [&](double tc) {
     state_at(t0, a0, tc, yc.data());
@@ -294,7 +383,8 @@ double StuckPropagator::locate(std::size_t k, double ta, double ga, double tb, d
 //   with u = conj(e_i) z, v = conj(e_i) z', a = conj(e_i) z'' (e_i = e^{i beta_i}):
 //   fn_i = -(Re a - 2 W Im v - W^2 Re u - W^2 - W' Im u),
 //   fw_i = -(Im a + 2 W Re v - W^2 Im u + W' (Re u + 1 - 2 dbar_i Jbar)).
-void StuckPropagator::margins(double W, double Wp, const double* y, double* g) {
+template <class Table>
+void StuckPropagatorT<Table>::margins(double W, double Wp, const double* y, double* g) {
   const cplx z(y[StateLayout::x], y[StateLayout::y]), zd(y[StateLayout::x_dot], y[StateLayout::y_dot]);
   const double bb = rs_.nd.bbar, W2 = W * W;
   const cplx zdd = C_ * cplx(W2, -Wp) - cplx(2 * bb, 2 * W) * zd - cplx(1 - W2, Wp + 2 * bb * W) * z;
@@ -310,7 +400,8 @@ void StuckPropagator::margins(double W, double Wp, const double* y, double* g) {
   }
 }
 
-StuckPropagator::Result StuckPropagator::advance(double& t, std::vector<double>& y, double tstop,
+template <class Table>
+typename StuckPropagatorT<Table>::Result StuckPropagatorT<Table>::advance(double& t, std::vector<double>& y, double tstop,
                                                  std::vector<int>& roots, double& peak_amp_mm) {
   const std::size_t n = rs_.n;
   C_ = cplx(rs_.nd.mbar_I * rs_.nd.ebar, 0.0);
@@ -389,5 +480,8 @@ StuckPropagator::Result StuckPropagator::advance(double& t, std::vector<double>&
   std::copy(ywork_.begin(), ywork_.begin() + StateLayout::table_size, y.begin());
   return Stop;
 }
+
+template class StuckPropagatorT<StuckForcingTable>;
+template class StuckPropagatorT<RunForcingTable>;
 
 }  // namespace abuopt::detail

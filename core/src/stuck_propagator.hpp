@@ -49,18 +49,24 @@ class StuckForcingTable {
   // The table applies to a run whose non-dimensional constants of the table rows are these.
   bool matches(const NondimParameters& nd) const { return nd.omega_n == omega_n_ && nd.bbar == bbar_; }
 
-  std::size_t intervals() const { return t_.size() - 1; }
-  double t(std::size_t j) const { return t_[j]; }
+  std::size_t intervals() const { return t_.size() - 1 + tail_n_; }
+  double t(std::size_t j) const;
   // Interval j with t_j <= tbar < t_{j+1} (the last one for tbar >= its end).
   std::size_t interval(double tbar) const;
   const cplx& lambda(int k) const { return lam_[k]; }
   const cplx& rho(int k) const { return rho_[k]; }
   // Grid values: e^{lambda_k (t_{j+1} - t_j)}, P_k over interval j, e^{-i phi(t_j)}, W(t_j).
-  const cplx& decay(int k, std::size_t j) const { return E_[2 * j + static_cast<std::size_t>(k)]; }
-  const cplx& forcing(int k, std::size_t j) const { return P_[2 * j + static_cast<std::size_t>(k)]; }
-  const cplx& unrotate(std::size_t j) const { return rot_[j]; }
-  double speed(std::size_t j) const { return W_[j]; }
-  double speed_rate(std::size_t j) const { return Wp_[j]; }
+  // The profile's segments are stored (at most kMaxStoredIntervals intervals, ~100 B each); the
+  // constant-speed span after the profile is not: its values are computed from its closed form
+  // when asked, so the table's memory does not grow with the end time.
+  cplx decay(int k, std::size_t j) const;
+  cplx forcing(int k, std::size_t j) const;
+  cplx unrotate(std::size_t j) const;
+  double speed(std::size_t j) const;
+  double speed_rate(std::size_t j) const;
+  // Above this many stored intervals (a very long profile) the constructor throws
+  // std::invalid_argument and the simulator keeps the Runge-Kutta path (bounded memory).
+  static constexpr std::size_t kMaxStoredIntervals = std::size_t{1} << 19;
 
   // W, W' and e^{i phi} at any tbar (from the profile).
   void sample(double tbar, double& W, double& Wp, cplx& eiphi) const;
@@ -77,14 +83,30 @@ class StuckForcingTable {
   std::vector<double> gl_x_, gl_w_;  // Gauss-Legendre nodes on [0, 1] and weights (sum 1)
   std::vector<double> t_, W_, Wp_;
   std::vector<cplx> E_, P_, rot_;
+  // The constant-speed tail [tail_a_, t_end_bar_]: tail_n_ intervals of tail_h_ (the last one
+  // ends at t_end_bar_), speed tail_W_, e^{i phi(tail_a_)} = tail_e0_, per-interval E and P / e^{i phi}.
+  std::size_t tail_n_ = 0;
+  double tail_a_ = 0, tail_h_ = 0, tail_W_ = 0;
+  cplx tail_e0_, tail_E_[2], tail_Fc_[2];
+  cplx tail_last_E_[2], tail_last_P_[2], tail_end_rot_;
+  double tail_end_W_ = 0, tail_end_Wp_ = 0;
+};
+
+// Gauss-Legendre nodes on [0, 1] and their weights (sum 1), m nodes.
+void gauss_legendre(int m, std::vector<double>& x, std::vector<double>& w);
+
+struct StuckPropagatorResult {
+  enum Result { Stop, Root, NotFinite };
 };
 
 // One run's use of the table: from a state with every ball stuck, advance to a stop time or to the
 // earliest root of the stick functions (the integrator's root functions, offsets included).
-class StuckPropagator {
+// Table: StuckForcingTable (the Simulator's, shared: runs with its omega_n and bbar) or
+// RunForcingTable (run_forcing_table.hpp: a run with its own, e.g. an uncertain stiffness).
+template <class Table>
+class StuckPropagatorT : public StuckPropagatorResult {
  public:
-  enum Result { Stop, Root, NotFinite };
-  StuckPropagator(const StuckForcingTable& tab, RunState& rs, RootFn g);
+  StuckPropagatorT(const Table& tab, RunState& rs, RootFn g);
   // On Root: t and y are at the root (on the far side of the crossing, as the stepper's roots),
   // roots[k] != 0 marks the functions that crossed. NotFinite: the state is not finite (NaN or
   // inf, e.g. from a non-finite angle); t and y are where it was found. The peak table amplitude [mm] over the grid
@@ -99,7 +121,7 @@ class StuckPropagator {
   void margins(double W, double Wp, const double* y, double* g);
   double locate(std::size_t k, double ta, double ga, double tb, double gb, const cplx a0[2], double t0);
 
-  const StuckForcingTable& tab_;
+  const Table& tab_;
   RunState& rs_;
   RootFn g_;
   cplx C_;
@@ -109,5 +131,9 @@ class StuckPropagator {
   long intervals_ = 0;
   double L_mm_ = 0;
 };
+
+using StuckPropagator = StuckPropagatorT<StuckForcingTable>;
+class RunForcingTable;
+using RunStuckPropagator = StuckPropagatorT<RunForcingTable>;
 
 }  // namespace abuopt::detail

@@ -11,8 +11,7 @@ namespace abuopt {
 namespace {
 
 constexpr double kTwoPi = 6.283185307179586476925286766559;
-constexpr std::uint64_t kTagFriction = 0x4652494354494f4eULL;   // "FRICTION"
-constexpr std::uint64_t kTagMass = 0x494d42414c4d4153ULL;       // "IMBALMAS"
+// kTagFriction and kTagMass: envelope.hpp (the envelope draws from the same streams)
 constexpr std::uint64_t kTagAngle = 0x494d42414c414e47ULL;      // "IMBALANG"
 
 std::string num(double v) {
@@ -55,7 +54,7 @@ bool UncertainParameters::deterministic() const {
   return (friction.sampling == FrictionSampling::Nominal || friction.sampling == FrictionSampling::Fixed ||
           (friction.sampling == FrictionSampling::List && friction.values.size() <= 1)) &&
          imbalance_mass.sampling == ImbalanceMassSampling::Nominal &&
-         imbalance_angle.sampling == ImbalanceAngleSampling::Fixed;
+         imbalance_angle.sampling == ImbalanceAngleSampling::Fixed && envelope.deterministic();
 }
 
 void validate(const UncertainParameters& u, const std::string& path) {
@@ -90,6 +89,14 @@ void validate(const UncertainParameters& u, const std::string& path) {
   }
   if (u.imbalance_angle.sampling == ImbalanceAngleSampling::Fixed && !std::isfinite(u.imbalance_angle.angle_rad))
     throw ConfigError(im + ".angle_rad", num(u.imbalance_angle.angle_rad), "must be finite");
+  validate(u.envelope, "envelope");
+  if (u.envelope.friction_mu.given() && u.friction.sampling != FrictionSampling::Nominal)
+    throw ConfigError("envelope.friction_mu", u.envelope.friction_mu.text(),
+                      "cannot be combined with " + f + " (give each uncertain parameter in one place: the envelope)");
+  if (u.envelope.imbalance_mass_factor.given() && u.imbalance_mass.sampling != ImbalanceMassSampling::Nominal)
+    throw ConfigError("envelope.imbalance_mass_factor", u.envelope.imbalance_mass_factor.text(),
+                      "cannot be combined with " + im +
+                          ".mass_relative_range (give each uncertain parameter in one place: the envelope)");
 }
 
 RunOverrides sample_overrides(const UncertainParameters& u, const AbuParameters& nominal, std::uint64_t seed,
@@ -108,6 +115,25 @@ RunOverrides sample_overrides(const UncertainParameters& u, const AbuParameters&
                           unit_double(hash_seed(seed, kTagMass, index)));
     o.imbalance_mass_kg = nominal.imbalance_mass_kg * (1.0 + r);
   }
+  // The envelope: each parameter from its own stream (the same streams as the keys above for
+  // friction and imbalance mass, which validate() keeps exclusive), folded into its half of the
+  // range by run i's cell (stratified), or the joint scrambled Sobol' point (sobol).
+  const Envelope& e = u.envelope;
+  const std::size_t cell = index % e.strata();
+  auto draw = [&](std::size_t k) {
+    const ParameterDistribution& d = e.parameter(k);
+    if (!d.varies()) return d.at(0.0);
+    if (e.sampling == EnvelopeSampling::Sobol) return d.at(joint_sobol_coordinate(seed, index, k));
+    const double v = unit_double(hash_seed(seed, envelope_tag(k), index));
+    if (e.sampling == EnvelopeSampling::Random) return d.at(v);
+    std::size_t bit = 0;  // this parameter's position among the varying ones: its bit of the cell
+    for (std::size_t q = 0; q < k; ++q) bit += e.parameter(q).varies() ? 1 : 0;
+    return d.at(0.5 * (static_cast<double>((cell >> bit) & 1u) + v));
+  };
+  if (e.friction_mu.given()) o.friction_mu = draw(0);
+  if (e.imbalance_mass_factor.given()) o.imbalance_mass_kg = nominal.imbalance_mass_kg * draw(1);
+  if (e.stiffness_factor.given()) o.stiffness_N_per_m = nominal.stiffness_N_per_m * draw(2);
+  if (e.restitution.given()) o.ball_restitution = draw(3);
   if (u.imbalance_angle.sampling == ImbalanceAngleSampling::Uniform)
     o.imbalance_angle_rad = kTwoPi * unit_double(hash_seed(seed, kTagAngle, index));
   else

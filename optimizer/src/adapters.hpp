@@ -33,4 +33,15 @@ AdapterOutcome run_sao(EvaluationDriver& driver, Problem& problem, const Optimiz
 // naming sao.samples.* when the problem's sample size cannot be chosen or is too small.
 void check_sao_sampling(const Problem& problem, const SaoOptions& sao);
 
+// pagmo2 (pagmo_adapter.cpp): PAGMO_CMAES, PAGMO_XNES, PAGMO_SADE, PAGMO_PSO.
+bool is_pagmo_algorithm(const std::string& canonical_name);
+// The population of a pagmo run on n variables: `requested` (optimizer.population) when > 0, else
+// max(8, 4 + floor(3 ln n)).
+std::size_t pagmo_population(const std::string& canonical_name, std::size_t n, long requested);
+// Before the run: ConfigError naming optimizer.population (below the algorithm's minimum) or
+// optimizer.max_evaluations (less than one population).
+void check_pagmo(const std::string& canonical_name, std::size_t n, const OptimizerOptions& options);
+AdapterOutcome run_pagmo(EvaluationDriver& driver, const AlgorithmInfo& algorithm, const OptimizerOptions& options,
+                         const std::vector<double>& x0);
+
 }  // namespace abuopt::opt::detail

@@ -47,6 +47,16 @@ const std::vector<AlgorithmInfo>& algorithms() {
       {"SAO", F::LocalDerivativeFree, true, true, false,
        "sequential approximate optimisation: least-squares response surfaces in a trust region; constraints "
        "of both kinds; for expensive, noisy problems (options in the sao: section)"},
+      {"PAGMO_CMAES", F::Global, true, true, false,
+       "pagmo2's CMA-ES (covariance matrix adaptation evolution strategy); constraints by feasibility rules; "
+       "seeded, population optimizer.population (default max(8, 4 + 3 ln n))"},
+      {"PAGMO_XNES", F::Global, true, true, false,
+       "pagmo2's exponential natural evolution strategy; constraints by feasibility rules; seeded"},
+      {"PAGMO_SADE", F::Global, true, true, false,
+       "pagmo2's self-adaptive differential evolution (jDE, rand/1/exp); constraints by feasibility rules; seeded"},
+      {"PAGMO_PSO", F::Global, true, true, false,
+       "pagmo2's generational particle swarm; every generation one batch of evaluations; constraints by "
+       "feasibility rules; seeded"},
   };
   return list;
 }

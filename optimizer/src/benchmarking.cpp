@@ -63,6 +63,14 @@ SolverSpec solver_spec(const std::string& label, const std::string& algorithm) {
 
 SolverSpec read_solver_spec(YamlReader& r) {
   SolverSpec s;
+  if (r.has("external")) {
+    s.external_runs = r.get_string("external");
+    if (s.external_runs.empty()) throw ConfigError(r.key_path("external"), "\"\"", "must name a directory");
+    s.label = r.get_string("label");
+    if (s.label.empty()) throw ConfigError(r.key_path("label"), "\"\"", "must not be empty");
+    r.finish();  // an external solver has no algorithm, options or stages
+    return s;
+  }
   const std::string algorithm = r.get_string("algorithm");
   find_algorithm(algorithm, r.key_path("algorithm"));
   s.label = r.get_string_or("label", algorithm);
@@ -200,6 +208,13 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
     if (find_algorithm(s.options.algorithm).name == "SAO") s.options.sao.validate("compare.solvers[" + s.label + "].sao");
     s.options.validate();
     if (s.then) s.then->validate();
+    if (!s.external_runs.empty())  // every external run exists before anything runs
+      for (const ProblemSpec& p : setup.problems)
+        for (int k = 0; k < p.starts; ++k)
+          if (!std::filesystem::exists(external_run_path(s.external_runs, p.label, k)))
+            throw ConfigError("compare.solvers[" + s.label + "].external", external_run_path(s.external_runs, p.label, k),
+                              "no such file: every problem and start needs its external run (made e.g. by "
+                              "examples/python/optuna_study.py)");
   }
 
   ComparisonResult out;
@@ -262,7 +277,11 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
         rec.sample_size = problem->sample_size();
         rec.x0 = starts[k];
         try {
-          if (solver.then) {
+          if (!solver.external_runs.empty()) {
+            rec.result = read_external_run(external_run_path(solver.external_runs, spec.label, k), *problem,
+                                           spec.constraint_tolerance, spec.max_evaluations);
+            rec.result.algorithm = "external";
+          } else if (solver.then) {
             TwoStageOptions two;
             two.first = o;
             two.then = *solver.then;
@@ -454,7 +473,7 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
     OutFile f(dir / "runs.csv", written);
     f << "problem,start,solver,algorithm,dimension,x0,reason,best_true_objective,feasible,objective,max_violation,"
          "evaluations,evaluations_to_tau,f_star,wall_time_s,samples,validated_objective,validated_max_violation,"
-         "validated_feasible,message\n";
+         "validated_feasible,message,x\n";
     for (const RunRecord& run : r.runs) {
       std::string x0;
       for (double v : run.x0) x0 += (x0.empty() ? "" : " ") + format_number(v);
@@ -471,7 +490,9 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
           << (run.validation_feasible ? 1 : 0) << ",";
       else
         f << ",,,";
-      f << csv_text(run.result.message) << "\n";
+      std::string x;  // the run's best point (what was validated)
+      for (double v : run.result.x) x += (x.empty() ? "" : " ") + format_number(v);
+      f << csv_text(run.result.message) << "," << x << "\n";
     }
     f.commit();
   }

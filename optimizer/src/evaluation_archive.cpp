@@ -12,6 +12,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "abuopt/common/output_file.hpp"
+
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/provenance.hpp"
 
@@ -105,6 +107,12 @@ std::string row_checksum(const std::string& problem_id, const std::string& x_key
 
 // SQLite's own verdict on a damaged file (as opposed to a busy or full one).
 bool is_corruption(int rc) { return (rc & 0xff) == SQLITE_CORRUPT || (rc & 0xff) == SQLITE_NOTADB; }
+// The file cannot be written (disk full, a file-size limit, no permission, read-only): an output
+// failure like any other file's (OutputError: exit status 4), not a failed computation.
+bool is_write_failure(int rc) {
+  const int p = rc & 0xff;
+  return p == SQLITE_FULL || p == SQLITE_IOERR || p == SQLITE_READONLY || p == SQLITE_CANTOPEN || p == SQLITE_PERM;
+}
 
 std::string now_utc() {
   const auto now = std::chrono::system_clock::now();
@@ -149,6 +157,7 @@ class Statement {
     if (is_corruption(rc))
       throw ConfigError("evaluation archive '" + path_ + "' is damaged (" + why +
                         "): move it away or delete it (its evaluations are recomputed)");
+    if (is_write_failure(rc)) throw OutputError("cannot write the evaluation archive " + path_ + ": " + why);
     throw std::runtime_error("evaluation archive '" + path_ + "': " + why);
   }
   std::string text(int col) const {
@@ -204,11 +213,13 @@ std::string EvaluationArchive::key_of(const std::vector<double>& x) { return hex
 
 EvaluationArchive::EvaluationArchive(const std::string& path, std::string problem_id)
     : path_(path), problem_id_(std::move(problem_id)) {
-  if (sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,
-                      nullptr) != SQLITE_OK) {
+  if (const int rc = sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,
+                                     nullptr);
+      rc != SQLITE_OK) {
     const std::string why = db_ ? sqlite3_errmsg(db_) : "out of memory";
     sqlite3_close(db_);
     db_ = nullptr;
+    if (is_write_failure(rc)) throw OutputError("cannot write the evaluation archive " + path + ": " + why);
     throw ConfigError("evaluation archive '" + path + "' cannot be opened: " + why);
   }
   sqlite3_busy_timeout(db_, 10000);
@@ -283,6 +294,10 @@ EvaluationArchive::EvaluationArchive(const std::string& path, std::string proble
     sqlite3_close(db_);
     db_ = nullptr;
     throw;
+  } catch (const OutputError&) {  // cannot be written: exit 4 as for any output file
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw;
   } catch (const std::exception& e) {
     sqlite3_close(db_);
     db_ = nullptr;
@@ -321,6 +336,7 @@ void EvaluationArchive::exec(const char* sql) const {
     if (is_corruption(rc))
       throw ConfigError("evaluation archive '" + path_ + "' is damaged (" + why +
                         "): move it away or delete it (its evaluations are recomputed)");
+    if (is_write_failure(rc)) throw OutputError("cannot write the evaluation archive " + path_ + ": " + why);
     throw std::runtime_error("evaluation archive '" + path_ + "': " + why);
   }
 }

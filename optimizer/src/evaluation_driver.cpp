@@ -1,5 +1,8 @@
 #include "evaluation_driver.hpp"
 
+#include "abuopt/common/output_file.hpp"
+#include "abuopt/common/stop.hpp"
+
 #include <algorithm>
 #include <csignal>
 #include <cmath>
@@ -30,7 +33,8 @@ int sigint_users = 0;                 // guarded by sigint_mutex()
 struct sigaction sigint_previous {};  // the handler before the first guard
 }  // namespace
 
-SigintGuard::SigintGuard(bool enable) : enabled_(enable) {
+SigintGuard::SigintGuard(bool enable) : enabled_(enable && !abuopt::stop_handlers_installed()) {
+  // the program's own handlers (abuopt/common/stop.hpp, app/main.cpp) already stop the run
   if (!enabled_) return;
   std::lock_guard<std::mutex> lock(sigint_mutex());
   if (sigint_users++ == 0) {
@@ -93,7 +97,7 @@ void EvaluationDriver::stop(TerminationReason reason, std::string message) {
 
 bool EvaluationDriver::check_limits() {
   if (stop_reason_) return true;
-  if (interrupt_flag().load()) {
+  if (interrupt_flag().load() || abuopt::stop_requested()) {
     stop(TerminationReason::Interrupted, "interrupted (SIGINT or request_stop) after " +
                                              std::to_string(evaluations_) + " evaluations");
   } else if (evaluations_ >= options_.max_evaluations) {
@@ -209,6 +213,22 @@ std::vector<const EvaluatedPoint*> EvaluationDriver::evaluate_batch(const std::v
 
 const EvaluatedPoint* EvaluationDriver::record(std::vector<double> x, bool clipped, BatchEvaluation b,
                                                bool for_gradient) {
+  if (b.error) {
+    // an evaluation stopped by the stop request (its Monte Carlo threw Interrupted between runs)
+    // is not an evaluation: nothing is recorded, the run ends as interrupted
+    try {
+      std::rethrow_exception(b.error);
+    } catch (const abuopt::Interrupted&) {
+      stop(TerminationReason::Interrupted,
+           "interrupted (SIGINT or request_stop) after " + std::to_string(evaluations_) + " evaluations");
+      return nullptr;
+    } catch (const abuopt::OutputError& e) {
+      fatal_ = b.error;
+      stop(TerminationReason::EvaluationError, e.what());
+      return nullptr;
+    } catch (...) {
+    }
+  }
   if (clipped) ++clipped_;
   EvaluatedPoint p;
   p.x = x;
@@ -314,7 +334,7 @@ const EvaluatedPoint* EvaluationDriver::record(std::vector<double> x, bool clipp
       stop(TerminationReason::StoppedByCallback, std::string("the callback threw: ") + ex.what());
     }
   }
-  if (interrupt_flag().load())
+  if (interrupt_flag().load() || abuopt::stop_requested())
     stop(TerminationReason::Interrupted,
          "interrupted (SIGINT or request_stop) after " + std::to_string(evaluations_) + " evaluations");
   if (options_.keep_history) history_.push_back(std::move(rec));

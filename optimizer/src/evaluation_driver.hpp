@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <deque>
+#include <exception>
 #include <limits>
 #include <map>
 #include <memory>
@@ -91,6 +92,9 @@ class EvaluationDriver {
   long samples() const { return samples_; }
 
   bool stopped() const { return stop_reason_.has_value(); }
+  // An evaluation that could not store its result (OutputError: the archive cannot be written)
+  // ends the run; minimize() rethrows it after the result is filled (exit status 4, not 3).
+  std::exception_ptr fatal_error() const { return fatal_; }
   std::optional<TerminationReason> stop_reason() const { return stop_reason_; }
   const std::string& stop_message() const { return stop_message_; }
   void stop(TerminationReason reason, std::string message);
@@ -137,6 +141,7 @@ class EvaluationDriver {
   double max_abs_constraint_ = 0.0;
   long evaluations_ = 0, archive_hits_ = 0, failed_ = 0, gradient_evals_ = 0, repeats_ = 0, clipped_ = 0;
   std::optional<TerminationReason> stop_reason_;
+  std::exception_ptr fatal_;
   std::string stop_message_;
 };
 

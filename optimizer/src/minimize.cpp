@@ -60,6 +60,7 @@ OptimizationResult minimize(Problem& problem, const OptimizerOptions& options, s
                           " needs at least 2 variables; problem '" + problem.name() + "' has 1 (use COBYLA or SBPLX)");
 
   if (algorithm.name == "SAO") detail::check_sao_sampling(problem, options.sao);
+  if (detail::is_pagmo_algorithm(algorithm.name)) detail::check_pagmo(algorithm.name, n, options);
 
   // ---- the run: from here on nothing throws; the best point so far is always returned ----
   detail::SigintGuard sigint(options.handle_sigint);
@@ -72,6 +73,8 @@ OptimizationResult minimize(Problem& problem, const OptimizerOptions& options, s
       outcome = detail::run_ipopt(driver, options, x0);
     else if (algorithm.name == "SAO")
       outcome = detail::run_sao(driver, problem, options, x0);
+    else if (detail::is_pagmo_algorithm(algorithm.name))
+      outcome = detail::run_pagmo(driver, algorithm, options, x0);
     else
       outcome = detail::run_nlopt(driver, algorithm, local, wrap, options, x0);
   } catch (const std::exception& ex) {
@@ -89,6 +92,7 @@ OptimizationResult minimize(Problem& problem, const OptimizerOptions& options, s
   r.inequality_names = problem.inequality_names();
   r.equality_names = problem.equality_names();
   driver.fill(r);
+  if (driver.fatal_error()) std::rethrow_exception(driver.fatal_error());  // e.g. the archive cannot be written
 
   if (driver.stopped()) {  // our own stop (budget, time, callback, interrupt, error, target) wins
     r.reason = *driver.stop_reason();

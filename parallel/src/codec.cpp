@@ -11,7 +11,7 @@ static_assert(sizeof(RunOutcome) == 160 || sizeof(void*) != 8,
               "RunOutcome changed: encode the new field in put_outcome/get_outcome and update this size");
 
 // Likewise for RunOverrides.
-static_assert(sizeof(RunOverrides) == 40 || sizeof(void*) != 8,
+static_assert(sizeof(RunOverrides) == 72 || sizeof(void*) != 8,
               "RunOverrides changed: encode the new field in put_inputs/get_inputs and update this size");
 
 void put_outcome(Writer& w, const RunOutcome& o) {
@@ -58,6 +58,10 @@ void put_inputs(Writer& w, const MonteCarloSample& s) {
   w.put(s.overrides.friction_mu.value_or(0.0));
   w.put<std::uint8_t>(s.overrides.imbalance_mass_kg ? 1 : 0);
   w.put(s.overrides.imbalance_mass_kg.value_or(0.0));
+  w.put<std::uint8_t>(s.overrides.stiffness_N_per_m ? 1 : 0);
+  w.put(s.overrides.stiffness_N_per_m.value_or(0.0));
+  w.put<std::uint8_t>(s.overrides.ball_restitution ? 1 : 0);
+  w.put(s.overrides.ball_restitution.value_or(0.0));
   w.put(s.overrides.imbalance_angle_rad);
 }
 
@@ -70,6 +74,12 @@ void get_inputs(Reader& r, std::vector<double>& beta0, RunOverrides& o) {
   const bool has_mass = r.get<std::uint8_t>() != 0;
   const double mass = r.get<double>();
   if (has_mass) o.imbalance_mass_kg = mass;
+  const bool has_k = r.get<std::uint8_t>() != 0;
+  const double k = r.get<double>();
+  if (has_k) o.stiffness_N_per_m = k;
+  const bool has_e = r.get<std::uint8_t>() != 0;
+  const double e = r.get<double>();
+  if (has_e) o.ball_restitution = e;
   o.imbalance_angle_rad = r.get<double>();
 }
 

@@ -190,6 +190,10 @@ void describe_fields(FieldArchive& a, StartupProfileSettings& s) {
   describe_fields(a, s.study.setup);  // abu, profile, motor, simulation
   a.section("montecarlo", [&] { describe_montecarlo_fields(a, s.study, s.threads); },
             FieldOptions::derived_defaults());
+  // The envelope of uncertain parameters: drawn per run like the montecarlo keys (envelope.hpp).
+  FieldOptions envelope;
+  envelope.enabled = a.reading() || !s.study.uncertain.envelope.empty();
+  a.section("envelope", [&] { describe_fields(a, s.study.uncertain.envelope); }, envelope);
   if (a.reading()) validate(s.study, "montecarlo");
   FieldOptions design = FieldOptions::required_key(
       "(design: {segments: [...]} with at least one free {min, max} value)");
@@ -200,6 +204,9 @@ void describe_fields(FieldArchive& a, StartupProfileSettings& s) {
       s.study.uncertain.friction.sampling != FrictionSampling::Nominal)
     throw ConfigError("objective.robust.friction_mu", list_text(s.objective.robust_friction_mu),
                       "cannot be combined with montecarlo.friction (give the friction values in one place)");
+  if (a.reading() && !s.objective.robust_friction_mu.empty() && s.study.uncertain.envelope.friction_mu.given())
+    throw ConfigError("objective.robust.friction_mu", list_text(s.objective.robust_friction_mu),
+                      "cannot be combined with envelope.friction_mu (give the friction values in one place)");
   a.nested("constraints", s.constraints);
   FieldOptions validation = FieldOptions::derived_defaults();
   validation.identity = false;  // the out-of-sample check does not decide evaluate(x)

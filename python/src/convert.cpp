@@ -17,7 +17,36 @@ std::string float_text(double v) {
 
 }  // namespace
 
+namespace {
+
+// The walk of to_yaml, bounded as the YAML reader bounds a file (kMaxConfigNodes values,
+// kMaxConfigDepth levels): a dict that contains itself, or lists that share lists exponentially,
+// would otherwise recurse until the interpreter dies or run out of memory.
+struct Walk {
+  double nodes = 0;
+};
+
+YAML::Node to_yaml_bounded(const py::handle& value, const std::string& path, std::size_t depth, Walk& walk);
+
+}  // namespace
+
 YAML::Node to_yaml(const py::handle& value, const std::string& path) {
+  Walk walk;
+  return to_yaml_bounded(value, path, 0, walk);
+}
+
+namespace {
+
+YAML::Node to_yaml_bounded(const py::handle& value, const std::string& path, std::size_t depth, Walk& walk) {
+  const std::string where = path.empty() ? std::string("<root>") : path;
+  if (depth > kMaxConfigDepth)
+    throw ConfigError(where, "<nested value>",
+                      "the config nests more than " + std::to_string(kMaxConfigDepth) +
+                          " levels deep (does a dict or list contain itself?)");
+  if (++walk.nodes > kMaxConfigNodes)
+    throw ConfigError(where, "<value>",
+                      "the config has more than 1e6 values (the limit of a config; lists or dicts shared many "
+                      "times over count each time)");
   if (value.is_none()) return YAML::Node(YAML::NodeType::Null);
   if (py::isinstance<py::bool_>(value)) return YAML::Node(value.cast<bool>() ? "true" : "false");
   if (py::isinstance<py::str>(value)) return YAML::Node(value.cast<std::string>());
@@ -28,7 +57,7 @@ YAML::Node to_yaml(const py::handle& value, const std::string& path) {
         throw py::type_error("config key " + py::repr(k).cast<std::string>() + (path.empty() ? "" : " in " + path) +
                              ": keys must be strings");
       const std::string key = k.cast<std::string>();
-      n[key] = to_yaml(v, path.empty() ? key : path + "." + key);
+      n[key] = to_yaml_bounded(v, path.empty() ? key : path + "." + key, depth + 1, walk);
     }
     return n;
   }
@@ -36,7 +65,7 @@ YAML::Node to_yaml(const py::handle& value, const std::string& path) {
     YAML::Node n(YAML::NodeType::Sequence);
     std::size_t i = 0;
     for (const auto& v : value) {
-      n.push_back(to_yaml(v, path + "[" + std::to_string(i) + "]"));
+      n.push_back(to_yaml_bounded(v, path + "[" + std::to_string(i) + "]", depth + 1, walk));
       ++i;
     }
     return n;
@@ -52,17 +81,21 @@ YAML::Node to_yaml(const py::handle& value, const std::string& path) {
     }
     PyErr_Clear();
   }
-  if (py::hasattr(value, "tolist")) return to_yaml(value.attr("tolist")(), path);  // NumPy arrays
+  if (py::hasattr(value, "tolist")) return to_yaml_bounded(value.attr("tolist")(), path, depth + 1, walk);  // NumPy arrays
   throw py::type_error("config value " + (path.empty() ? std::string("<root>") : path) + " = " +
                        py::repr(value).cast<std::string>() +
                        ": must be a dict, list, str, int, float, bool or None (YAML values)");
 }
 
+}  // namespace
+
 YamlReader load_config(const py::handle& config) {
   if (py::isinstance<py::dict>(config)) return YamlReader(to_yaml(config, ""), "");
   py::object os = py::module_::import("os");
   if (py::isinstance<py::str>(config) || py::hasattr(config, "__fspath__")) {
+    // the whole name, NULs included: load_file refuses a name with a NUL (it is not cut there)
     const std::string path = os.attr("fspath")(config).cast<std::string>();
+    if (path.find('\0') != std::string::npos) return YamlReader::load_file(path);
     // A missing file is Python's FileNotFoundError (an OSError, as open() raises), not a ConfigError.
     if (!os.attr("path").attr("exists")(path).cast<bool>()) {
       PyErr_SetObject(PyExc_FileNotFoundError,

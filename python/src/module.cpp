@@ -2,7 +2,13 @@
 // with configs read by the same C++ readers (a ConfigError becomes abuopt.ConfigError, a
 // ValueError) and the GIL released while simulating.
 #include <cmath>
+#include <chrono>
+#include <condition_variable>
+#include <csignal>
+#include <exception>
 #include <memory>
+#include <mutex>
+#include <thread>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,6 +20,8 @@
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/config_sections.hpp"
 #include "bindings.hpp"  // register_module_extras, register_archive
+#include "abuopt/common/stop.hpp"
+#include "abuopt/common/text.hpp"
 #include "abuopt/core/batch_runner.hpp"
 #include "abuopt/core/equilibrium_set.hpp"
 #include "abuopt/core/monte_carlo.hpp"
@@ -23,6 +31,7 @@
 #include "abuopt/optimizer/optimizer_options.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
 #include "convert.hpp"
+#include "problem_bindings.hpp"
 
 namespace py = pybind11;
 
@@ -31,6 +40,58 @@ namespace abuopt::python {
 namespace {
 
 using Array = py::array_t<double>;
+
+// Runs `work` (no Python inside) on a worker thread while the calling thread, the GIL released
+// between polls, checks Python's signals every 50 ms: Ctrl-C (KeyboardInterrupt, or whatever a
+// SIGINT handler of the program raises) sets abuopt's stop request (abuopt/common/stop.hpp), the
+// Monte Carlo stops between runs (its work is thrown away), and the Python exception is raised
+// here within about a second instead of after the whole run. The stop request is process-wide:
+// calls running at the same time in other Python threads stop too.
+template <class Work>
+void run_interruptible(Work&& work) {
+  std::mutex m;
+  std::condition_variable cv;
+  bool done = false;
+  std::exception_ptr error;
+  std::thread worker([&] {
+    try {
+      work();
+    } catch (...) {
+      error = std::current_exception();
+    }
+    const std::lock_guard<std::mutex> lock(m);
+    done = true;
+    cv.notify_one();
+  });
+  bool interrupted = false;
+  while (true) {
+    {
+      py::gil_scoped_release release;
+      std::unique_lock<std::mutex> lock(m);
+      if (cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return done; })) break;
+    }
+    if (!interrupted && PyErr_CheckSignals() != 0) {  // the Python error (KeyboardInterrupt) is set
+      interrupted = true;
+      request_stop(SIGINT);
+    }
+  }
+  {
+    py::gil_scoped_release release;
+    worker.join();
+  }
+  if (interrupted) {
+    clear_stop();
+    throw py::error_already_set();
+  }
+  if (error) std::rethrow_exception(error);
+}
+
+// Initial angles and other per-call numbers from Python: finite, as the command line requires.
+void require_finite(const std::vector<double>& v, const std::string& key) {
+  for (std::size_t i = 0; i < v.size(); ++i)
+    if (!std::isfinite(v[i]))
+      throw ConfigError(key + "[" + std::to_string(i) + "]", format_number(v[i]), "must be a finite angle in rad");
+}
 
 py::dict outcome_dict(const RunOutcome& o) {
   py::dict d;
@@ -54,20 +115,20 @@ py::dict outcome_dict(const RunOutcome& o) {
 py::dict simulate(const py::handle& config, const std::vector<double>& beta0) {
   YamlReader root = load_config(config);
   SimulationSetup setup = read_simulation_setup(root);
-  if (root.has("montecarlo")) (void)read_monte_carlo_config(root, setup);
+  if (root.has("montecarlo") || root.has("envelope")) (void)read_monte_carlo_config(root, setup);
   finish_config(root);
   const std::size_t n = setup.abu.balls.size();
   if (beta0.size() != n)
     throw ConfigError("beta0", std::to_string(beta0.size()) + " angles",
                       "must give " + std::to_string(n) + " angles (one per ball)");
+  require_finite(beta0, "beta0");
   RunOutcome o;
   double I0 = 0;
-  {
-    py::gil_scoped_release release;
+  run_interruptible([&] {
     Simulator sim(setup);
     o = sim.run(beta0, {});
     I0 = setup.abu.imbalance_kgm();
-  }
+  });
   py::dict d = outcome_dict(o);
   d["beta0"] = Array(static_cast<py::ssize_t>(beta0.size()), beta0.data());
   d["imbalance_without_balls"] = I0;
@@ -84,7 +145,7 @@ void override_key(YamlReader& root, const char* key, const std::optional<T>& val
 }
 
 py::dict montecarlo(const py::handle& config, std::optional<long long> runs, std::optional<std::string> design,
-                    std::optional<long long> seed, std::optional<long long> threads) {
+                    std::optional<long long> seed, std::optional<long long> threads, long long max_runs) {
   YamlReader loaded = load_config(config);
   if (!loaded.node().IsMap()) throw ConfigError("<root>", "", "the config must be a mapping of sections");
   override_key(loaded, "design", design);
@@ -95,15 +156,22 @@ py::dict montecarlo(const py::handle& config, std::optional<long long> runs, std
   SimulationSetup setup = read_simulation_setup(root);
   MonteCarloConfig cfg = read_monte_carlo_config(root, std::move(setup));
   finish_config(root);
+  // Every run's outcome is returned as arrays (about 0.5 kB per run with the study's own copy):
+  // above max_runs the caller asks for it explicitly.
+  if (max_runs < 1) throw ConfigError("max_runs", std::to_string(max_runs), "must be >= 1");
+  if (cfg.study.runs > static_cast<std::size_t>(max_runs))
+    throw ConfigError("montecarlo.runs", std::to_string(cfg.study.runs),
+                      "is more than max_runs = " + std::to_string(max_runs) +
+                          " (the default limit of one call: every run is kept in memory, about 0.5 kB each); pass "
+                          "max_runs=N to allow more");
 
   MonteCarloResult result;
   MonteCarloStats stats;
-  {
-    py::gil_scoped_release release;
+  run_interruptible([&] {
     ThreadPoolRunner runner(cfg.threads);
     result = run_monte_carlo(cfg.study, runner);
     stats = compute_statistics(result);
-  }
+  });
   const std::size_t n = result.samples.size();
   const std::size_t nb = cfg.study.setup.abu.balls.size();
   Array ir(n), irx(n), settling(n), amp(n), end(n), mu(n), imb(n), wall(n);
@@ -160,7 +228,9 @@ py::dict montecarlo(const py::handle& config, std::optional<long long> runs, std
 
 py::dict equilibrium_set(const py::handle& config, double freq, std::size_t grid,
                          const std::vector<double>& other_angles) {
-  if (!(std::isfinite(freq) && freq > 0)) throw ConfigError("freq", std::to_string(freq), "must be a frequency > 0 Hz");
+  if (!(std::isfinite(freq) && freq > 0 && freq <= kMaxEquilibriumFrequencyHz))
+    throw ConfigError("freq", format_number(freq),
+                      "must be a frequency in (0, 1e6] Hz (above it the steady amplitude overflows double precision)");
   if (grid < 2 || grid > 4096) throw ConfigError("grid", std::to_string(grid), "must be in [2, 4096] (points per axis)");
   YamlReader root = load_config(config);
   const SimulationSetup setup = read_simulation_setup(root);
@@ -171,6 +241,7 @@ py::dict equilibrium_set(const py::handle& config, double freq, std::size_t grid
     throw ConfigError("other_angles", std::to_string(other_angles.size()) + " angles",
                       "must give the fixed angles of balls 3.." + std::to_string(nb) + " (" + std::to_string(nb - 2) +
                           " values)");
+  require_finite(other_angles, "other_angles");
   std::optional<EquilibriumSet> set;
   EquilibriumGrid g;
   {
@@ -234,8 +305,7 @@ class PyStartupProfileProblem {
       throw std::invalid_argument("x has " + std::to_string(x.size()) + " entries; the problem has " +
                                   std::to_string(vars_.size()) + " variables");
     if (!(has_last_ && x == last_x_)) {
-      py::gil_scoped_release release;
-      last_ = problem_->evaluate(x);
+      run_interruptible([&] { last_ = problem_->evaluate(x); });
       last_x_ = x;
       has_last_ = true;
       ++evaluations_;
@@ -310,8 +380,11 @@ PYBIND11_MODULE(abuopt, m) {
         "Units: SI (imbalances in kg m), as in every function of this module.");
   m.def("montecarlo", &montecarlo, py::arg("config"), py::kw_only(), py::arg("runs") = py::none(),
         py::arg("design") = py::none(), py::arg("seed") = py::none(), py::arg("threads") = py::none(),
+        py::arg("max_runs") = 1000000,
         "Monte Carlo over initial ball angles, as `abuopt montecarlo`. runs/design/seed/threads override\n"
-        "the config's montecarlo.runs/.design/.seed/.threads (checked as those keys). Returns a dict of\n"
+        "the config's montecarlo.runs/.design/.seed/.threads (checked as those keys); more runs than\n"
+        "max_runs (default 10^6: every run is kept in memory) is an error unless max_runs is raised.\n"
+        "Ctrl-C stops the runs within about a second and raises KeyboardInterrupt. Returns a dict of\n"
         "NumPy arrays, one entry per run: residual_imbalance and residual_imbalance_x [kg m], beta0 and\n"
         "beta_final (runs x balls) [rad], status (str), ok, settled, settling_time [s], max_amplitude_mm,\n"
         "end_time_s, friction_mu, imbalance_kgm [kg m], reused, events, steps, rhs_evaluations,\n"
@@ -353,4 +426,6 @@ PYBIND11_MODULE(abuopt, m) {
       .def_property_readonly("evaluations", &PyStartupProfileProblem::evaluations,
                              "Monte Carlo evaluations done (repeats of the last x not counted)")
       .def("startup_time_s", &PyStartupProfileProblem::startup_time_s, py::arg("x"));
+
+  register_problem_bindings(m);  // BatchProblem (problem_bindings.cpp)
 }

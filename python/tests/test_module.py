@@ -195,6 +195,43 @@ def main():
     few = arc.evaluations(where=[f"objective<={best['objective']}"])
     check(len(few["id"]) >= 1 and np.all(few["objective"] <= best["objective"]), "Archive.evaluations(where=...) filters")
 
+    # 6b. Hardening (issue 29): bad numbers raise as on the command line; a dict that contains
+    # itself, a path with a NUL, too many runs are errors, not a crash; Ctrl-C stops a long call.
+    for bad_angle in (float("nan"), float("inf"), -float("inf")):
+        e = error_of(lambda: abuopt.simulate(cfg, beta0=[bad_angle, 1.0]))
+        check(e is not None and "beta0[0]" in str(e), f"simulate beta0=[{bad_angle}, 1] raises naming beta0[0]: {e}")
+    eqcfg = os.path.join(a.source, "configs", "eqset.yaml")
+    e = error_of(lambda: abuopt.equilibrium_set(eqcfg, 1e300, grid=8))
+    check(e is not None and "freq" in str(e) and "1e6" in str(e), f"equilibrium_set above 1e6 Hz raises: {e}")
+    e = error_of(lambda: abuopt.equilibrium_set({"abu": {"ball_count": 3}}, 29.0, grid=8, other_angles=[float("nan")]))
+    check(e is not None and "other_angles[0] = nan" in str(e), f"other_angles=[nan] (3 balls) raises: {e}")
+    loop = {}
+    loop["abu"] = loop
+    e = error_of(lambda: abuopt.simulate(loop, beta0=beta0))
+    check(e is not None and "levels deep" in str(e), f"a dict that contains itself raises: {e}")
+    e = error_of(lambda: abuopt.simulate(cfg + "\0.txt", beta0=beta0))
+    check(e is not None and "NUL" in str(e), f"a path with an embedded NUL raises (not cut at the NUL): {e}")
+    e = error_of(lambda: abuopt.montecarlo(cfg, runs=2000000, design="random"))
+    check(e is not None and "max_runs" in str(e), f"2e6 runs without max_runs raises naming it: {e}")
+    child = ("import abuopt, sys\n"
+             "try:\n"
+             f"    abuopt.montecarlo({cfg!r}, runs=100000, design='random')\n"
+             "    print('ENDED')\n"
+             "except KeyboardInterrupt:\n"
+             "    print('INTERRUPTED')\n")
+    import signal
+    import time
+    proc = subprocess.Popen([sys.executable, "-c", child], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, env=dict(os.environ))
+    time.sleep(3.0)  # the import and the config first
+    sent = time.monotonic()
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    latency = time.monotonic() - sent
+    print(f"Ctrl-C during montecarlo(100000 runs): ended {latency:.2f} s after SIGINT")
+    check("INTERRUPTED" in out and latency < 2.0,
+          f"Ctrl-C stops a long montecarlo with KeyboardInterrupt within 2 s ({latency:.2f} s; {out.strip()} {err[-300:]})")
+
     # 9. The examples, quick mode (ABUOPT_QUICK=1 set by ctest).
     env = dict(os.environ, ABUOPT_QUICK="1", MPLBACKEND="Agg")
     for script, args in [("montecarlo_histogram.py", ["--out", os.path.join(a.work, "histogram.png")]),

@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 
+#include "abuopt/common/stop.hpp"
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/text.hpp"
@@ -194,7 +195,12 @@ SweepResult run_sweep(opt::Problem& problem, opt::EvaluationArchive& archive, co
       ++r.archive_hits;
     } else {
       const auto t = clock::now();
-      p.e = problem.evaluate(p.x);
+      try {
+        p.e = problem.evaluate(p.x);
+      } catch (const Interrupted&) {  // the stop request ended the point's runs: not a point
+        r.interrupted = true;
+        break;
+      }
       p.wall_time_s = std::chrono::duration<double>(clock::now() - t).count();
       p.e.from_archive = false;
       if (p.e.ok) opt::check_evaluation_shape(n_ineq, n_eq, p.e);

@@ -1,5 +1,5 @@
 // The command line under hostile or unlucky input (issue 12): every case ends with a clear message
-// and one of the documented exit statuses (0, 2, 3, 4, 130), never a crash, a hang, NaN printed as
+// and one of the documented exit statuses (0, 2, 3, 4, 130, 143), never a crash, a hang, NaN printed as
 // a result, or "wrote ..." for a file that was not written.
 #include <gtest/gtest.h>
 #include <sys/file.h>

@@ -68,7 +68,7 @@ TEST(SimulateCli, BadInputGivesOneClearMessageAndStatus2) {
       {"abu: {balls: [{mass_kg: 1e-4, diameter_m: 0.02}]}\n", "",
        "abu.balls[0].diameter_m = 0.02: must be smaller than abu.ball_track_radius_m (0.0115)"},
       {"simulation: {rtol: 1e-6}\n", "--beta0 1,2,3", "--beta0 = 1,2,3: must give 2 angles (one per ball)"},
-      {"{}\n", "--beta0 1,x", "--beta0 = 1,x: must be a comma-separated list of angles in rad"},
+      {"{}\n", "--beta0 1,x", "--beta0 = 1,x: 'x' is not a number; must be a comma-separated list of finite angles in rad"},
   };
   int k = 0;
   for (const auto& c : cases) {

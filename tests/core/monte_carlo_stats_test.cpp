@@ -190,12 +190,13 @@ TEST(MonteCarloStats, CsvHasOneLinePerRunAndRoundTrips) {
   std::string line;
   std::getline(is, line);
   EXPECT_EQ(line,
-            "index,beta0_1,beta0_2,mu,imbalance_mass_kg,imbalance_angle_rad,beta_final_1,beta_final_2,"
+            "index,beta0_1,beta0_2,mu,imbalance_mass_kg,imbalance_angle_rad,stiffness_N_per_m,restitution,beta_final_1,"
+            "beta_final_2,"
             "ir_magnitude_kgm,ir_x_kgm,settled,settling_time_s,max_amplitude_mm,events,rhs_evaluations,status");
   std::getline(is, line);
-  EXPECT_EQ(line, "0,0,1,0.02,,0,1.5,4.5,1e-06,5e-07,1,4,0.2,7,1234,ok");
+  EXPECT_EQ(line, "0,0,1,0.02,,0,0,0,1.5,4.5,1e-06,5e-07,1,4,0.2,7,1234,ok");
   std::getline(is, line);
-  EXPECT_EQ(line, "1,0.1,1,0.02,0.00055,0,1.5,4.5,3e-06,2e-06,1,8,0.5,7,1234,ok");
+  EXPECT_EQ(line, "1,0.1,1,0.02,0.00055,0,0,0,1.5,4.5,3e-06,2e-06,1,8,0.5,7,1234,ok");
   std::getline(is, line);
   EXPECT_EQ(line.substr(line.rfind(',') + 1), "solver_failure");
   int rest = 0;

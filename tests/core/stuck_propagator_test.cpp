@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <complex>
 #include <random>
@@ -230,4 +231,42 @@ TEST(StuckForcingTable, SharedTablesAreReusedForTheSameProfileAndTableOnly) {
     EXPECT_EQ(b->forcing(1, j), fresh.forcing(1, j));
   }
   EXPECT_EQ(StuckForcingTable::kSharedTables, 4u);
+}
+
+// The constant-speed span after the profile is not stored (issue 29: a run of end_time_s 1e6 grew
+// to 12.6 GB): a table over 1e7 s is built at once, and its values on that span equal the
+// quadrature of the same integrals (P_k by Gauss-Legendre, e^{lambda h}, e^{-i phi} from the
+// profile) at interval boundaries near the profile's end, in the middle and at the end.
+TEST(StuckForcingTable, TheConstantSpeedSpanAfterTheProfileIsComputedNotStored) {
+  const auto nd = abuopt::NondimParameters::from(AbuParameters{});
+  const StartupProfile p({{25.0, 1.0}, {29.5, 10.0}, {100.0, 8.0}});
+  const double tend = 1e7 * nd.omega_n;
+  const auto t0 = std::chrono::steady_clock::now();
+  const StuckForcingTable tab(p, nd, tend);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 2.0);
+  EXPECT_GT(tab.intervals(), 1e9);  // every interval is still there, as values computed when asked
+  EXPECT_EQ(tab.t(tab.intervals()), tend);
+  const std::size_t stored = tab.interval(19.0 * nd.omega_n + 1e-9);  // the first interval of the span
+  for (const std::size_t j : {stored, stored + 1, stored + 12345, tab.intervals() / 2, tab.intervals() - 2,
+                              tab.intervals() - 1}) {
+    const double a = tab.t(j), b = tab.t(j + 1);
+    ASSERT_LT(a, b) << j;
+    EXPECT_EQ(tab.interval(0.5 * (a + b)), j);
+    EXPECT_EQ(tab.interval(a), j);
+    // the phase grows to ~1e10 rad at the end: e^{i phi} from the span's start and from the
+    // profile's revolution count agree to the rounding of a phase that large (~1e-6 rad)
+    const double tol = j > tab.intervals() / 4 ? 1e-4 : 1e-9;
+    cplx P[2];
+    tab.partial(a, b - a, P);
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_LT(std::abs(tab.forcing(k, j) - P[k]), tol * std::abs(P[k]) + 1e-12) << j;
+      EXPECT_LT(std::abs(tab.decay(k, j) - std::exp(tab.lambda(k) * (b - a))), tol) << j;  // b - a rounds at 4e9
+    }
+    double W, Wp;
+    cplx e;
+    tab.sample(b, W, Wp, e);
+    EXPECT_LT(std::abs(tab.unrotate(j + 1) - std::conj(e)), tol) << j;
+    EXPECT_DOUBLE_EQ(tab.speed(j + 1), W);
+    EXPECT_EQ(tab.speed_rate(j + 1), 0.0);
+  }
 }

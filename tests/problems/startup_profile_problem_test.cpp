@@ -327,6 +327,15 @@ TEST(StartupProfileProblem, IdentityChangesWithWhatDecidesTheValues) {
   EXPECT_NE(changed("montecarlo:", "abu: {friction_mu: 0.03}\nmontecarlo:"), base);
   EXPECT_NE(changed("montecarlo:", "objective: {definition: report_x}\nmontecarlo:"), base);
   EXPECT_NE(changed("montecarlo:", "simulation: {rtol: 1e-7}\nmontecarlo:"), base);
+  EXPECT_NE(changed("montecarlo:", "envelope: {stiffness_factor: {uniform: [0.95, 1.05]}}\nmontecarlo:"), base);
+  {  // the envelope reaches the study the problem evaluates
+    std::string y = kThreeStep;
+    y.replace(y.find("montecarlo:"), 11, "envelope: {friction_mu: {uniform: [0.02, 0.04]}}\nmontecarlo:");
+    EXPECT_EQ(settings_from(y).study.uncertain.envelope.friction_mu, ParameterDistribution::uniform(0.02, 0.04));
+    EXPECT_NE(error_of([&] { settings_from(y + "objective: {robust: {friction_mu: [0.02, 0.03]}}\n"); })
+                  .find("envelope.friction_mu"),
+              std::string::npos);
+  }
   // Bounds, x0, threads and validation do not change any value: same identity (archive reused).
   EXPECT_EQ(changed("{min: 15, max: 28, x0: 25}", "{min: 14, max: 28, x0: 20}"), base);
   EXPECT_EQ(changed("threads: 1", "threads: 2"), base);

@@ -34,6 +34,13 @@ struct Rule {
   static Rule non_negative_at_most(double hi);  // 0 <= v <= hi ("must be >= 0" / "must be <= hi")
 };
 
+// The size of a config document with every alias expanded, and its nesting depth: more is refused
+// (a config is a few hundred values; nested aliases, "billion laughs", or a structure that contains
+// itself would otherwise take unbounded time and memory). The same limits hold for a config given
+// as a Python dict (python/src/convert.cpp).
+inline constexpr double kMaxConfigNodes = 1e6;
+inline constexpr std::size_t kMaxConfigDepth = 64;
+
 class YamlReader {
  public:
   YamlReader() = default;

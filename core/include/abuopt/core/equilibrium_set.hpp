@@ -35,6 +35,11 @@
 
 namespace abuopt {
 
+// The largest constant speed an equilibrium set is computed for: the steady amplitude grows with
+// (2 pi f)^4 terms, and 1e6 Hz keeps every product finite (`eqset --freq/--scan`, Python's
+// equilibrium_set).
+inline constexpr double kMaxEquilibriumFrequencyHz = 1e6;
+
 // One configuration tested for membership.
 struct EquilibriumPoint {
   double xbar = 0, ybar = 0;     // steady table position / L (rotating frame)

@@ -4,6 +4,7 @@
 // Run i of a study is a pure function of (study, i):
 //   beta0     = point i of the initial-condition design (initial_conditions.hpp),
 //   overrides = sample_overrides(study.uncertain, setup.abu, study.seed, i) (hash of (seed, i)),
+//   (with the envelope's joint sampling, beta0 and the overrides are one scrambled Sobol' point),
 //   outcome   = the per-sample function (by default Simulator::run) of (beta0, overrides).
 // The engine writes outcome i into slot i of a pre-sized vector, whatever worker ran it, so the
 // results are bit-identical for any thread count or batch backend, and run_one(study, i) replays
@@ -47,6 +48,12 @@ struct MonteCarloStudy {
 // True when the setup's balls are all identical (same mass and diameter), i.e. exchangeable.
 bool balls_exchangeable(const SimulationSetup& setup);
 
+// True when run i's start angles come from the envelope's joint scrambled Sobol' point (not the
+// design): envelope.sampling sobol, a varying envelope parameter, and design random or sobol.
+// Then the runs form Envelope::kReplicates independent scramblings (run i in i mod 16), and
+// mean_interval95 (monte_carlo_stats.hpp) takes the interval from their means.
+bool joint_sampling(const MonteCarloStudy& s);
+
 // The design the study actually uses: `design` with balls = setup.abu.balls.size() and, unless it
 // is a grid, count = runs.
 InitialConditionDesign study_design(const MonteCarloStudy& s);
@@ -64,6 +71,8 @@ struct MonteCarloSample {
   RunOverrides overrides;
   double friction_mu = 0;     // effective mu of this run (override or nominal)
   double imbalance_kgm = 0;   // effective m_I e of this run: the %MI threshold
+  double stiffness_N_per_m = 0;  // effective k of this run
+  double restitution = 0;        // effective ball-ball restitution of this run
   RunOutcome outcome;
 };
 
@@ -152,6 +161,7 @@ struct MonteCarloConfig {
 //   shift: true       halton/sobol: Cranley-Patterson random shift from the seed
 //   threads: 0        0 = all cores
 //   friction: {...}, imbalance: {...}   (uncertain_parameters.hpp)
+// and the top-level `envelope` section (envelope.hpp) into study.uncertain.envelope.
 // `setup` (read before, e.g. by read_simulation_setup) becomes study.setup. Validates the study.
 // The caller still calls root.finish().
 MonteCarloConfig read_monte_carlo_config(YamlReader& root, SimulationSetup setup);

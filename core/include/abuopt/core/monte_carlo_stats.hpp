@@ -79,6 +79,20 @@ struct MonteCarloStats {
 MonteCarloStats compute_statistics(const std::vector<MonteCarloSample>& samples);
 MonteCarloStats compute_statistics(const MonteCarloResult& result);  // adds wall time, concurrency
 
+// Half-width of the 95 % interval of the mean |I_r| (report_x: I_r,x, in kg m) over the ok runs,
+// for the study's sampling (mean_interval_groups): independent runs: 1.96 s / sqrt(n); strata
+// (the envelope's stratified draws, run i in cell i mod H, weights 1/H): 1.96 sqrt(sum s_h^2 /
+// (H^2 n_h)); replicates (scrambled Sobol', run i in replicate i mod R): t_{R-1} sd(replicate
+// means) / sqrt(R). NaN when there are too few ok runs.
+enum class IntervalKind { Independent, Strata, Replicates };
+struct IntervalLayout {
+  IntervalKind kind = IntervalKind::Independent;
+  std::size_t groups = 1;
+};
+IntervalLayout interval_layout(const MonteCarloStudy& s);
+double mean_half_width95(const std::vector<MonteCarloSample>& samples, const IntervalLayout& layout,
+                         bool report_x = false);
+
 // The summary as one JSON object: runs, ok, failed, status_counts {key: n}, pct_lc, not_settled,
 // wall_time_s, concurrency, magnitude {...}, report_x {...} (count, mean, min, max, median, p10,
 // p90, p95, mi_count, pct_mi, pct_mi_ci95 [lo, hi]), settling_time_s {settled, mean, median, max},
@@ -117,7 +131,7 @@ SmoothImbalanceStats compute_smooth_statistics(const std::vector<MonteCarloSampl
 
 // Per-run CSV: header, then one line per sample in index order. Columns:
 // index, beta0_1..beta0_N, mu, imbalance_mass_kg (empty when nominal), imbalance_angle_rad,
-// beta_final_1..beta_final_N, ir_magnitude_kgm, ir_x_kgm, settled, settling_time_s,
+// stiffness_N_per_m, restitution (this run's effective values: the envelope's draws), beta_final_1..beta_final_N, ir_magnitude_kgm, ir_x_kgm, settled, settling_time_s,
 // max_amplitude_mm, events, rhs_evaluations, status. Numbers round-trip exactly (shortest form).
 void write_runs_csv(std::ostream& os, const std::vector<MonteCarloSample>& samples);
 

@@ -63,6 +63,8 @@ struct SimulationOptions {
 struct RunOverrides {
   std::optional<double> friction_mu;
   std::optional<double> imbalance_mass_kg;
+  std::optional<double> stiffness_N_per_m;  // > 0
+  std::optional<double> ball_restitution;   // in [0, 1] (hard contact)
   double imbalance_angle_rad = 0;  // rotates the imbalance; reported angles stay imbalance-relative
 };
 

@@ -13,6 +13,10 @@
 //                      [-0.1, 0.1] for +-10 %), m_I being the setup's abu.imbalance_mass_kg.
 //   imbalance angle:   Fixed angle_rad (default 0: the model's frame), or Uniform in [0, 2 pi).
 //                      Outcomes stay imbalance-relative (see RunOverrides).
+//   envelope:          the top-level `envelope` section (envelope.hpp): friction, imbalance mass,
+//                      stiffness, restitution, drawn with the same hashing. The place new configs
+//                      use; a parameter given both here and in montecarlo.friction /
+//                      montecarlo.imbalance.mass_relative_range is a ConfigError.
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -20,6 +24,7 @@
 
 #include "abuopt/common/config_fields.hpp"
 #include "abuopt/common/yaml_reader.hpp"
+#include "abuopt/core/envelope.hpp"
 #include "abuopt/core/parameters.hpp"
 #include "abuopt/core/simulator.hpp"
 
@@ -54,24 +59,26 @@ struct UncertainParameters {
   FrictionUncertainty friction;
   ImbalanceMassUncertainty imbalance_mass;
   ImbalanceAngleUncertainty imbalance_angle;
+  Envelope envelope;  // the `envelope` section (not a key of `montecarlo`)
 
   // True when every run gets the same overrides (no randomness, no list).
   bool deterministic() const;
 };
 
 // Throws ConfigError (keys below `path`) for negative or non-finite friction, an empty list,
-// lo > hi, or a relative range reaching m_I <= 0 (lo <= -1).
+// lo > hi, a relative range reaching m_I <= 0 (lo <= -1), an invalid envelope, or a parameter
+// given both in the envelope and in the `montecarlo` keys.
 void validate(const UncertainParameters& u, const std::string& path = "montecarlo");
 
 // The overrides of run `index` of a study with seed `seed`. `nominal` gives m_I for the relative
-// range. Pure function of its arguments.
+// range and the envelope's factors. Pure function of its arguments.
 RunOverrides sample_overrides(const UncertainParameters& u, const AbuParameters& nominal, std::uint64_t seed,
                               std::size_t index);
 
 extern const EnumNames<ImbalanceAngleSampling> kImbalanceAngleNames;  // fixed, uniform
 
 // The keys `friction` and `imbalance` of the `montecarlo` section (one field list: reading,
-// writing, validation, identity).
+// writing, validation, identity). The envelope is its own section (describe_fields(a, Envelope&)).
 void describe_fields(FieldArchive& a, UncertainParameters& u);
 
 // Reads the uncertain parameters from the `montecarlo` section (keys `friction`, `imbalance`):

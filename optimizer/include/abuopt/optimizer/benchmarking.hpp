@@ -53,12 +53,24 @@ struct SolverSpec {
   std::optional<OptimizerOptions> then;
   double first_fraction = 0.3;
   double penalty_weight = 100.0;
+  // Runs made outside abuopt (e.g. examples/python/optuna_study.py): when not empty, nothing is run;
+  // run k on problem P is read from external_run_path(external_runs, P, k) (read_external_run).
+  std::string external_runs;
 };
+// <directory>/<problem label, file-safe>/start<k>.csv
+std::string external_run_path(const std::string& directory, const std::string& problem_label, int start);
+// An external run's history (external_runs.cpp: evaluation,ok,objective,max_violation,<variables>)
+// as an OptimizationResult: feasible per constraint_tolerance, the best point as minimize() picks
+// it. ConfigError naming the file (and line) for a missing file, a wrong header, a bad number, a
+// point outside the bounds, or more evaluations than max_evaluations (> 0).
+OptimizationResult read_external_run(const std::string& path, const Problem& problem, double constraint_tolerance,
+                                     long max_evaluations);
 // A solver with default settings; `algorithm` is checked (ConfigError listing the valid names).
 SolverSpec solver_spec(const std::string& label, const std::string& algorithm);
 // Reads one solver entry: label, algorithm (any minimize() name or sao), optional `options:`
 // (the keys of an optimizer: section except algorithm) and `sao:` sections, and optionally a second
 // stage: `then: {algorithm: cobyla, options: {...}}`, `first_fraction: 0.3`, `penalty_weight: 100`.
+// Or an external solver: `{label: Optuna-TPE, external: DIR}` (no algorithm; SolverSpec::external_runs).
 SolverSpec read_solver_spec(YamlReader& entry);
 
 // Makes a fresh instance of a problem (called once per run).

@@ -61,11 +61,11 @@ struct OptimizerOptions {
   // Carlo) need a step well above the noise, e.g. 1e-3.
   double fd_relative_step = 0.0;
 
-  // Seed of the stochastic algorithms (CRS2_LM, ISRES, ESCH, MLSL_LDS); the same seed gives the
-  // same run.
+  // Seed of the stochastic algorithms (CRS2_LM, ISRES, ESCH, MLSL_LDS, the PAGMO_* methods); the
+  // same seed gives the same run.
   unsigned long seed = 1;
-  // Population of CRS2_LM, ISRES, ESCH and the number of starts per MLSL_LDS iteration; 0: the
-  // algorithm's default.
+  // Population of CRS2_LM, ISRES, ESCH and the PAGMO_* methods, and the number of starts per
+  // MLSL_LDS iteration; 0: the algorithm's default.
   long population = 0;
   // First step of the derivative-free local algorithms as a fraction of each variable's range;
   // 0: NLopt's own choice.

@@ -25,6 +25,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "abuopt/common/stop.hpp"
 #include "abuopt/core/batch_runner.hpp"
 
 namespace abuopt::opt {
@@ -35,9 +36,9 @@ namespace abuopt::parallel {
 
 // Thrown by a Monte Carlo over ranks that was interrupted (SIGTERM on a rank: Ctrl-C to mpirun,
 // scancel); a command reports it and ends with status 130.
-class Interrupted : public std::runtime_error {
+class Interrupted : public abuopt::Interrupted {  // the one stop of abuopt/common/stop.hpp
  public:
-  using std::runtime_error::runtime_error;
+  using abuopt::Interrupted::Interrupted;
 };
 
 // True once this process (or, on rank 0, a serving rank) got SIGTERM under MPI.

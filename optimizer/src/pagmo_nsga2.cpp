@@ -1,0 +1,188 @@
+// NSGA-II of pagmo2 on two objectives (multi_objective.hpp): the problem's objective and one metric.
+#include <pagmo/algorithm.hpp>
+#include <pagmo/algorithms/nsga2.hpp>
+#include <pagmo/batch_evaluators/member_bfe.hpp>
+#include <pagmo/bfe.hpp>
+#include <pagmo/population.hpp>
+#include <pagmo/problem.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "abuopt/common/config_error.hpp"
+#include "abuopt/optimizer/multi_objective.hpp"
+#include "evaluation_driver.hpp"
+
+namespace abuopt::opt {
+
+namespace {
+
+constexpr double kInfeasible = 1e30;
+constexpr double kFailed = 1e300;
+
+struct RunStopped {};
+
+struct Context {
+  detail::EvaluationDriver* driver = nullptr;
+  std::string metric;
+  double tolerance = 0.0;
+};
+
+std::vector<double> scaled(const detail::EvaluationDriver& d, const double* u) {
+  std::vector<double> y(d.n());
+  for (std::size_t i = 0; i < d.n(); ++i)
+    y[i] = d.lower_scaled()[i] + std::min(std::max(u[i], 0.0), 1.0) * (d.upper_scaled()[i] - d.lower_scaled()[i]);
+  return y;
+}
+
+std::pair<double, double> objectives(const detail::EvaluatedPoint& p, const Context& c) {
+  const auto m = p.e.metrics.find(c.metric);
+  if (!p.e.ok || !std::isfinite(p.e.objective) || m == p.e.metrics.end() || !std::isfinite(m->second))
+    return {kFailed, kFailed};
+  if (p.violation > c.tolerance) {
+    const double v = kInfeasible * (1.0 + std::min(p.violation, 1e250));
+    return {v, v};
+  }
+  return {p.e.objective, m->second};
+}
+
+struct TwoObjectiveUdp {
+  Context* ctx = nullptr;
+  std::size_t n = 0;
+  pagmo::vector_double fitness(const pagmo::vector_double& u) const { return batch_fitness(u); }
+  pagmo::vector_double batch_fitness(const pagmo::vector_double& dvs) const {
+    const std::size_t k = dvs.size() / n;
+    std::vector<std::vector<double>> ys;
+    for (std::size_t i = 0; i < k; ++i) ys.push_back(scaled(*ctx->driver, dvs.data() + i * n));
+    const auto ps = ctx->driver->evaluate_batch(ys);
+    pagmo::vector_double f;
+    for (const auto* p : ps) {
+      if (!p) throw RunStopped{};
+      const auto o = objectives(*p, *ctx);
+      f.push_back(o.first);
+      f.push_back(o.second);
+    }
+    return f;
+  }
+  pagmo::vector_double::size_type get_nobj() const { return 2; }
+  std::pair<pagmo::vector_double, pagmo::vector_double> get_bounds() const {
+    return {pagmo::vector_double(n, 0.0), pagmo::vector_double(n, 1.0)};
+  }
+};
+
+}  // namespace
+
+std::vector<std::pair<double, double>> TwoObjectiveResult::front_objectives() const {
+  std::vector<std::pair<double, double>> out;
+  for (std::size_t i : front) {
+    const EvaluationRecord& h = run.history[i];
+    out.emplace_back(h.objective, h.metrics.at(second_objective));
+  }
+  return out;
+}
+
+std::vector<std::pair<double, double>> non_dominated_2d(std::vector<std::pair<double, double>> points) {
+  std::sort(points.begin(), points.end());
+  std::vector<std::pair<double, double>> front;
+  for (const auto& p : points)
+    if (front.empty() || p.second < front.back().second) front.push_back(p);  // sorted: same first, larger second
+  return front;
+}
+
+double hypervolume_2d(const std::vector<std::pair<double, double>>& points, std::pair<double, double> reference) {
+  double area = 0.0, last_y = reference.second;
+  for (const auto& p : non_dominated_2d(points)) {
+    if (!(p.first < reference.first) || !(p.second < last_y)) continue;
+    area += (reference.first - p.first) * (last_y - p.second);
+    last_y = p.second;
+  }
+  return area;
+}
+
+TwoObjectiveResult minimize_two_objectives(Problem& problem, const std::string& second_objective,
+                                           const OptimizerOptions& options, std::vector<double> x0) {
+  options.validate();
+  check_problem(problem);
+  if (second_objective.empty())
+    throw ConfigError("second_objective", "\"\"", "must name a metric of the problem's evaluations");
+  const long size = options.population > 0 ? options.population : 20;
+  if (size < 8 || size % 4 != 0)
+    throw ConfigError("optimizer.population", std::to_string(size), "NSGA-II needs a multiple of 4, at least 8");
+  if (options.max_evaluations < size)
+    throw ConfigError("optimizer.max_evaluations", std::to_string(options.max_evaluations),
+                      "NSGA-II needs at least one population (" + std::to_string(size) + " evaluations)");
+  if (x0.empty()) x0 = problem.initial_point();
+  check_design_vector(problem, x0, "starting point");
+
+  detail::SigintGuard sigint(options.handle_sigint);
+  detail::interrupt_flag().store(false);
+  const EvaluationCallback none;
+  detail::EvaluationDriver driver(problem, options, none);
+  const std::size_t n = driver.n();
+  Context ctx{&driver, second_objective, options.constraint_tolerance};
+  TwoObjectiveResult out;
+  out.second_objective = second_objective;
+  TerminationReason reason = TerminationReason::Converged;
+  std::string message = "pagmo: NSGA-II ran its generations";
+  try {
+    pagmo::problem prob{TwoObjectiveUdp{&ctx, n}};
+    std::vector<double> flat;
+    {
+      const std::vector<double> y0 = driver.to_scaled(x0);
+      for (std::size_t i = 0; i < n; ++i)
+        flat.push_back(std::min(std::max((y0[i] - driver.lower_scaled()[i]) /
+                                             (driver.upper_scaled()[i] - driver.lower_scaled()[i]),
+                                         0.0),
+                                1.0));
+      std::mt19937_64 rng(options.seed ^ 0x9e3779b97f4a7c15ULL);
+      std::uniform_real_distribution<double> uniform(0.0, 1.0);
+      while (flat.size() < static_cast<std::size_t>(size) * n) flat.push_back(uniform(rng));
+    }
+    const pagmo::vector_double f = prob.extract<TwoObjectiveUdp>()->batch_fitness(flat);
+    pagmo::population pop(prob, 0u, static_cast<unsigned>(options.seed) + 1u);
+    for (long i = 0; i < size; ++i)
+      pop.push_back(pagmo::vector_double(flat.begin() + i * static_cast<long>(n), flat.begin() + (i + 1) * static_cast<long>(n)),
+                    {f[2 * i], f[2 * i + 1]});
+    // generations: as many as evaluations (repeats of known points are answered from memory and do
+    // not count), so the budget ends the run
+    const unsigned generations = static_cast<unsigned>(std::min<long>(options.max_evaluations, 100000000L));
+    pagmo::nsga2 nsga(generations, 0.95, 10., 1. / static_cast<double>(std::max<std::size_t>(n, 1)), 20.,
+                      static_cast<unsigned>(options.seed));
+    nsga.set_bfe(pagmo::bfe(pagmo::member_bfe{}));
+    pagmo::algorithm(std::move(nsga)).evolve(pop);
+  } catch (const RunStopped&) {
+    reason = TerminationReason::MaxEvaluations;
+  } catch (const std::exception& ex) {
+    reason = TerminationReason::Failure;
+    message = std::string("the optimiser threw: ") + ex.what();
+  }
+  OptimizationResult& r = out.run;
+  r.problem_name = problem.name();
+  r.algorithm = "PAGMO_NSGA2";
+  r.x0 = x0;
+  for (const Variable& v : problem.variables()) r.variable_names.push_back(v.name);
+  r.inequality_names = problem.inequality_names();
+  r.equality_names = problem.equality_names();
+  driver.fill(r);
+  r.reason = driver.stopped() ? *driver.stop_reason() : reason;
+  r.message = driver.stopped() ? driver.stop_message() : message;
+  // the front: non-dominated feasible evaluations of the whole run
+  std::vector<std::pair<std::pair<double, double>, std::size_t>> feasible;
+  for (std::size_t i = 0; i < r.history.size(); ++i) {
+    const EvaluationRecord& h = r.history[i];
+    const auto m = h.metrics.find(second_objective);
+    if (h.feasible && m != h.metrics.end() && std::isfinite(m->second)) feasible.push_back({{h.objective, m->second}, i});
+  }
+  std::sort(feasible.begin(), feasible.end());
+  double last = std::numeric_limits<double>::infinity();
+  for (const auto& [o, i] : feasible)
+    if (o.second < last) {
+      out.front.push_back(i);
+      last = o.second;
+    }
+  if (detail::interrupt_flag().load()) detail::interrupt_flag().store(false);
+  return out;
+}
+
+}  // namespace abuopt::opt

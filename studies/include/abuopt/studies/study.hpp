@@ -1,0 +1,164 @@
+#pragma once
+// `abuopt study STUDY.yaml`: a whole design study as one declarative file (docs/study.md).
+//
+//   StudyFile f = read_study_file("configs/studies/quick.yaml");   // strict YAML, ConfigError
+//   StudyResult r = run_study(f, {.out = "results/quick"});          // stages, archive, resume
+//   write_study_report(f, r, "results/quick");                       // report.html/.md, summary.json, designs/
+//
+// The file says everything: the ABU (`abu`, `motor`, `simulation`), the envelope of uncertain
+// parameters (`envelope`), the initial-angle sampling (`sampling`), the `baseline` profile, the
+// profile `family` (free values with bounds, frequencies optionally in units of the ABU's natural
+// frequency), discrete `choices` (ball count at a total ball mass), the `objective` and
+// `constraints` (absolute, or relative to the baseline), the `stages` and one `budget`.
+// Stage kinds (one file each, studies/src/study_stage_*.cpp):
+//   global     an optimiser of the registry from the family's starting point
+//   local      an optimiser from the best design so far (a polish)
+//   replicate  the best design of every choice on fresh samples (other seeds): the recommended
+//              design is the best mean objective among those feasible on every replication
+//   validate   the recommended design and the baseline on fresh, larger samples (intervals over
+//              the seeds), and their ratio over a (mu, imbalance) map of the envelope
+// Every Monte Carlo goes through one SQLite evaluation archive (OUT/archive.sqlite): a rerun after
+// Ctrl-C or kill -9 recomputes nothing it stored and ends with the same results; results do not
+// depend on the thread count (common random numbers, seeded optimisers).
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "abuopt/core/monte_carlo.hpp"
+#include "abuopt/optimizer/optimization_result.hpp"
+#include "abuopt/optimizer/optimizer_options.hpp"
+#include "abuopt/problems/startup_profile_problem.hpp"
+
+namespace abuopt::studies {
+
+enum class StageKind { Global, Local, Replicate, Validate };
+extern const EnumNames<StageKind> kStageKindNames;  // global, local, replicate, validate
+std::string to_string(StageKind k);
+
+struct StageSpec {
+  StageKind kind = StageKind::Global;
+  std::string name;                 // default: the kind (made unique: "local_2")
+  opt::OptimizerOptions optimizer;  // global, local
+  double penalty_weight = 10.0;     // global/local with an optimiser that takes bounds only
+  std::vector<std::uint64_t> seeds; // replicate, validate: one fresh sample per seed
+  std::size_t runs = 0;             // replicate, validate: runs per sample (0: the sampling's runs)
+  // validate: the ratio map over the envelope (empty: no map)
+  std::vector<double> map_friction_mu;
+  std::vector<double> map_imbalance_factor;  // x abu.imbalance_mass_kg
+  std::size_t map_runs = 0;         // runs per map point (0: the stage's runs)
+};
+
+struct RelativeConstraints {
+  std::optional<double> amplitude_vs_baseline;             // A <= factor x the baseline's A
+  std::optional<double> angular_acceleration_vs_baseline;  // peak a <= factor x the baseline's
+  std::optional<double> startup_time_vs_baseline;          // T <= factor x the baseline's T
+};
+
+struct StudyFile {
+  std::string path;                  // the file as given
+  std::string title;
+  MonteCarloStudy base;              // abu, motor, simulation, baseline profile, sampling, envelope
+  std::size_t threads = 0;           // Monte Carlo workers (0: all cores); results do not depend on it
+  bool frequencies_natural = false;  // family: free frequency values in units of f_n = sqrt(k/M)/2pi
+  problems::ProfileDesign family;    // as written (natural units not yet applied)
+  std::vector<std::size_t> ball_counts;  // choices (one entry: the abu's balls)
+  std::optional<double> total_ball_mass_kg;
+  problems::ObjectiveSettings objective;
+  problems::ConstraintSettings constraints;
+  RelativeConstraints relative;
+  std::vector<StageSpec> stages;
+  long max_evaluations = 1000;       // budget: optimiser evaluations over every stage and choice
+};
+
+// Reads and validates a study file. Throws ConfigError naming the key, the value and the rule.
+StudyFile read_study_file(const std::string& path);
+
+// The ABU of one choice (ball count at the total mass) and the problem settings of that choice:
+// family frequencies in Hz, relative constraints resolved against `baseline` metrics.
+AbuParameters abu_of_choice(const StudyFile& f, std::size_t balls);
+problems::StartupProfileSettings settings_of_choice(const StudyFile& f, std::size_t balls,
+                                                    const std::map<std::string, double>& baseline_metrics);
+// Which free end frequencies can reach f_n (Hz); empty message when one can.
+std::string resonance_reach_text(const problems::ProfileDesign& d, double natural_frequency_hz);
+
+// One evaluated design (a point of one stage).
+struct StudyDesign {
+  std::string label;          // "balls2_local" ...
+  std::size_t balls = 0;
+  std::string stage;
+  std::vector<std::string> variable_names;
+  std::vector<double> x;
+  StartupProfile profile;
+  opt::Evaluation in_sample;
+  std::vector<opt::Evaluation> replications;  // replicate stage
+  bool robust_feasible = false;               // feasible on every replication (or in sample without them)
+  double replicated_objective = 0.0;          // mean over replications (in-sample objective without them)
+};
+
+struct StageTrace {
+  std::string stage;
+  std::size_t balls = 0;
+  std::string algorithm;
+  std::string reason;
+  long evaluations = 0, archive_hits = 0;
+  std::vector<double> objective;       // every evaluation (NaN: failed)
+  std::vector<double> best_feasible;   // best feasible so far (NaN: none yet)
+};
+
+// A metric over fresh samples: mean and a 95 % t-interval over the seeds.
+struct Interval {
+  double mean = 0.0, lo = 0.0, hi = 0.0;
+  std::size_t samples = 0;
+};
+Interval interval_of(const std::vector<double>& values);
+
+struct ValidationResult {
+  bool done = false;
+  std::size_t runs = 0;
+  std::vector<std::uint64_t> seeds;
+  std::map<std::string, Interval> design, baseline;  // per metric
+  Interval ratio_mean_ir;                            // design / baseline mean |I_r|, per seed
+  std::vector<double> map_mu, map_imbalance;
+  std::vector<std::vector<double>> map_ratio;        // [imbalance factor][mu]: design / baseline mean |I_r|
+  std::size_t map_runs = 0;
+  // Final ball angles [deg] of the recommended design and the baseline on the first fresh sample
+  // (two balls only), over the equilibrium set at the last frequency and the nominal friction.
+  std::vector<std::pair<double, double>> final_design, final_baseline;
+  std::size_t eq_n = 0;            // the set's grid: eq_n x eq_n over [0, 360)^2 deg
+  std::vector<char> eq_in_set;     // row-major: index i * eq_n + j = (beta_1 = i, beta_2 = j)
+  double eq_frequency_hz = 0, eq_mu = 0;
+};
+
+struct StudyResult {
+  bool interrupted = false;
+  double wall_time_s = 0.0;
+  long evaluations = 0, archive_hits = 0;
+  opt::Evaluation baseline;                    // baseline profile, in sample
+  double baseline_peak_acceleration = 0.0;
+  std::vector<std::string> constraint_names;
+  std::vector<std::string> notes;              // resonance reach, unmet constraints, ...
+  std::vector<StudyDesign> designs;            // every stage's best, per choice
+  std::optional<std::size_t> recommended;      // index into designs
+  std::vector<StageTrace> traces;
+  ValidationResult validation;
+};
+
+struct StudyRunOptions {
+  std::string out;                                 // directory (archive.sqlite goes there)
+  std::optional<std::size_t> threads;              // overrides the file's
+  std::function<void(const std::string&)> log;     // one line at a time
+  std::function<void(long done, long total)> progress;  // evaluations of the budget
+  std::function<bool()> stop_requested;            // polled between evaluations
+};
+
+StudyResult run_study(const StudyFile& f, const StudyRunOptions& o);
+
+// report.html, report.md, summary.json and designs/<label>.yaml (ready for `abuopt montecarlo`).
+// Returns the files written.
+std::vector<std::string> write_study_report(const StudyFile& f, const StudyResult& r, const std::string& out_dir);
+
+}  // namespace abuopt::studies

@@ -1,0 +1,156 @@
+// The study file (studies/study.hpp): reading, the family's bounds relative to the natural
+// frequency, the relative constraints, the resonance note and the bad-input messages.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "abuopt/common/config_error.hpp"
+#include "abuopt/studies/study.hpp"
+
+namespace {
+
+using namespace abuopt;
+using namespace abuopt::studies;
+namespace fs = std::filesystem;
+
+const std::string kQuick = std::string(ABUOPT_SOURCE_DIR) + "/configs/studies/quick.yaml";
+
+std::string quick_text() {
+  std::ifstream in(kQuick);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// Writes `text` to a temporary file and reads it as a study.
+StudyFile read_text(const std::string& text) {
+  const fs::path p = fs::temp_directory_path() / ("abuopt_study_test_" + std::to_string(::getpid()) + ".yaml");
+  std::ofstream(p) << text;
+  StudyFile f = read_study_file(p.string());
+  fs::remove(p);
+  return f;
+}
+
+// The ConfigError message of reading `text` ("" when it reads).
+std::string error_of(const std::string& text) {
+  try {
+    read_text(text);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string replace(std::string s, const std::string& from, const std::string& to) {
+  const auto at = s.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) s.replace(at, from.size(), to);
+  return s;
+}
+
+TEST(StudyFile, QuickStudyReads) {
+  const StudyFile f = read_study_file(kQuick);
+  ASSERT_EQ(f.stages.size(), 4u);
+  EXPECT_EQ(f.stages[0].kind, StageKind::Global);
+  EXPECT_EQ(f.stages[3].kind, StageKind::Validate);
+  EXPECT_EQ(f.stages[3].seeds.size(), 4u);
+  EXPECT_TRUE(f.frequencies_natural);
+  ASSERT_EQ(f.ball_counts.size(), 1u);
+  EXPECT_EQ(f.ball_counts[0], 2u);
+  EXPECT_EQ(f.base.runs, 64u);
+  EXPECT_EQ(f.base.uncertain.envelope.friction_mu.kind, DistributionKind::Uniform);
+  EXPECT_EQ(f.base.uncertain.envelope.imbalance_mass_factor.hi, 1.2);
+}
+
+TEST(StudyFile, FrequencyBoundsFollowTheNaturalFrequency) {
+  const std::string text = quick_text();
+  const StudyFile soft = read_text(text);
+  const StudyFile stiff = read_text(replace(text, "abu: {}", "abu: {stiffness_N_per_m: 4.28e4}"));
+  const auto s1 = settings_of_choice(soft, 2, {{"amplitude_max_mm", 0.5}});
+  const auto s2 = settings_of_choice(stiff, 2, {{"amplitude_max_mm", 0.5}});
+  const double fn1 = s1.study.setup.abu.natural_frequency_hz(), fn2 = s2.study.setup.abu.natural_frequency_hz();
+  EXPECT_NEAR(fn1, 28.9, 0.05);  // the report's ABU
+  EXPECT_NEAR(fn2 / fn1, 2.0, 1e-12);  // four times as stiff: twice the natural frequency
+  EXPECT_NEAR(s1.design.segments[0].end_frequency_hz.lower, 0.6 * fn1, 1e-12);
+  EXPECT_NEAR(s2.design.segments[0].end_frequency_hz.lower, 0.6 * fn2, 1e-12);
+  EXPECT_NEAR(s2.design.segments[1].end_frequency_hz.upper, 1.1 * fn2, 1e-12);
+  EXPECT_NEAR(s2.design.segments[0].end_frequency_hz.value, 0.9 * fn2, 1e-12);
+  // fixed values stay in Hz (the operating speed)
+  EXPECT_EQ(s2.design.segments[2].end_frequency_hz.value, 100.0);
+  EXPECT_FALSE(s2.design.segments[2].end_frequency_hz.free);
+}
+
+TEST(StudyFile, RelativeConstraintsUseTheBaseline) {
+  const StudyFile f = read_study_file(kQuick);
+  const auto s = settings_of_choice(f, 2, {{"amplitude_max_mm", 0.484}});
+  ASSERT_TRUE(s.constraints.max_amplitude_mm);
+  EXPECT_DOUBLE_EQ(*s.constraints.max_amplitude_mm, 0.484);
+  ASSERT_TRUE(s.constraints.max_startup_time_s);
+  EXPECT_DOUBLE_EQ(*s.constraints.max_startup_time_s, 19.0);
+  ASSERT_TRUE(s.constraints.max_angular_acceleration_rad_s2);  // 2 pi x 2 x 25 Hz / 1 s
+  EXPECT_NEAR(*s.constraints.max_angular_acceleration_rad_s2, 2 * M_PI * 50, 1e-9);
+}
+
+TEST(StudyFile, BallCountsAtATotalMass) {
+  const std::string text =
+      replace(quick_text(), "objective: {kind: mean}", "choices: {balls: {counts: [2, 3], total_mass_kg: 4.2e-4}}\nobjective: {kind: mean}");
+  const StudyFile f = read_text(text);
+  ASSERT_EQ(f.ball_counts.size(), 2u);
+  const AbuParameters three = abu_of_choice(f, 3);
+  ASSERT_EQ(three.balls.size(), 3u);
+  EXPECT_NEAR(three.balls[0].mass_kg, 1.4e-4, 1e-18);
+}
+
+TEST(StudyFile, ResonanceOutOfReachIsSaid) {
+  const std::string text = replace(replace(quick_text(), "frequency_unit: natural", "frequency_unit: hz"),
+                                   "{min: 0.97, max: 1.1, x0: 1.02}", "{min: 20, max: 28, x0: 25}");
+  const std::string text2 = replace(text, "{min: 0.6, max: 0.99, x0: 0.9}", "{min: 15, max: 25, x0: 20}");
+  const StudyFile f = read_text(text2);
+  const auto s = settings_of_choice(f, 2, {{"amplitude_max_mm", 0.5}});
+  const std::string note = resonance_reach_text(s.design, 28.9);
+  EXPECT_NE(note.find("cannot reach the resonance"), std::string::npos) << note;
+  EXPECT_NE(note.find("28.9 Hz"), std::string::npos) << note;
+  EXPECT_NE(note.find("f2 in [20, 28] Hz"), std::string::npos) << note;
+  // the quick study's own family reaches it
+  const StudyFile q = read_study_file(kQuick);
+  const auto sq = settings_of_choice(q, 2, {{"amplitude_max_mm", 0.5}});
+  EXPECT_EQ(resonance_reach_text(sq.design, sq.study.setup.abu.natural_frequency_hz()), "");
+}
+
+TEST(StudyFile, BadInputNamesKeyValueAndRule) {
+  const std::string q = quick_text();
+  std::string e = error_of(replace(q, "runs: 64, seed: 21", "runs: 64, seed: 21, colour: red"));
+  EXPECT_NE(e.find("sampling.colour"), std::string::npos) << e;
+  e = error_of(replace(q, "{kind: global, optimizer: {algorithm: direct_l, max_evaluations: 30}}",
+                       "{kind: global, optimizer: {algorithm: direct_l, max_evaluations: 30}, seeds: [1]}"));
+  EXPECT_NE(e.find("stages[0].seeds"), std::string::npos) << e;
+  EXPECT_NE(e.find("only used by replicate and validate"), std::string::npos) << e;
+  e = error_of(replace(q, "kind: validate", "kind: check"));
+  EXPECT_NE(e.find("stages[3].kind = check"), std::string::npos) << e;
+  e = error_of(replace(q, "  - {kind: replicate, seeds: [101, 102, 103], runs: 64}\n", "") + "");
+  EXPECT_EQ(e, "");
+  e = error_of(replace(q, "- {kind: global, optimizer: {algorithm: direct_l, max_evaluations: 30}}",
+                       "- {kind: replicate, seeds: [1]}"));
+  EXPECT_NE(e.find("stages[0].kind = replicate"), std::string::npos) << e;
+  e = error_of(replace(q, "amplitude_vs_baseline: 1.0", "amplitude_vs_baseline: 1.0\n  max_amplitude_mm: 0.5"));
+  EXPECT_NE(e.find("constraints.amplitude_vs_baseline"), std::string::npos) << e;
+  e = error_of(replace(q, "algorithm: cobyla", "algorithm: nelder"));
+  EXPECT_NE(e.find("unknown algorithm"), std::string::npos) << e;
+  e = error_of(replace(q, "friction_mu: {uniform: [0.02, 0.04]}", "friction_mu: {uniform: [0.04, 0.02]}"));
+  EXPECT_NE(e.find("envelope.friction_mu"), std::string::npos) << e;
+  e = error_of(replace(q, "runs: 64, seed: 21}", "runs: 64, seed: 21, friction: {range: [0.02, 0.04]}}"));
+  EXPECT_NE(e.find("sampling.friction"), std::string::npos) << e;
+  EXPECT_NE(e.find("envelope"), std::string::npos) << e;
+  e = error_of(replace(q, "{min: 0.97, max: 1.1, x0: 1.02}", "{min: 0.97, max: 1.1, x0: 1.5}"));
+  EXPECT_NE(e.find("family.segments[1].end_frequency_hz"), std::string::npos) << e;
+}
+
+TEST(StudyInterval, StudentT) {
+  const Interval i = interval_of({1.0, 2.0, 3.0});
+  EXPECT_DOUBLE_EQ(i.mean, 2.0);
+  EXPECT_NEAR(i.hi - i.mean, 4.303 / std::sqrt(3.0), 1e-12);
+  EXPECT_EQ(interval_of({5.0}).lo, 5.0);
+}
+
+}  // namespace
