@@ -2,12 +2,13 @@
 // `pareto` from Python, through the same library functions (studies/optimize_run.hpp, sweep.hpp,
 // pareto.hpp) on a config read by the same readers. Results are dicts with attribute access (as
 // scipy.optimize.OptimizeResult) holding NumPy arrays. The work runs on a worker thread with the
-// GIL released; Ctrl-C stops it at the library's next safe point (after the current evaluation)
+// GIL released; Ctrl-C stops it at the library's next safe point (within the current evaluation)
 // and raises KeyboardInterrupt (what was evaluated stays in the archive when `out` is given).
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <csignal>
 #include <exception>
 #include <filesystem>
 #include <limits>
@@ -28,6 +29,7 @@
 #include "abuopt/common/config_sections.hpp"
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/provenance.hpp"
+#include "abuopt/common/stop.hpp"
 #include "abuopt/optimizer/evaluation_archive.hpp"
 #include "abuopt/optimizer/optimizer_options.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
@@ -49,7 +51,9 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Runs `work` (no Python inside) on a worker thread while this thread, the GIL released between
 // polls, checks Python's signals every 50 ms. On a signal (Ctrl-C: KeyboardInterrupt is set) `stop`
-// is set, the library stops at its next safe point, and the Python exception is raised here.
+// and the process's stop request are set, the library stops at its next safe point (the running
+// evaluation's Monte Carlo between runs, not recorded), and the Python exception is raised here.
+// (module.cpp's run_interruptible does the same for one Monte Carlo.)
 template <class Work>
 void run_stoppable(std::atomic<bool>& stop, Work&& work) {
   std::mutex m;
@@ -76,13 +80,17 @@ void run_stoppable(std::atomic<bool>& stop, Work&& work) {
     if (!interrupted && PyErr_CheckSignals() != 0) {  // the Python error (KeyboardInterrupt) is set
       interrupted = true;
       stop.store(true);
+      request_stop(SIGINT);  // the process's stop request (common/stop.hpp): a Monte Carlo stops between runs
     }
   }
   {
     py::gil_scoped_release release;
     worker.join();
   }
-  if (interrupted) throw py::error_already_set();
+  if (interrupted) {
+    clear_stop();  // the next call starts afresh
+    throw py::error_already_set();
+  }
   if (error) std::rethrow_exception(error);
 }
 
@@ -535,7 +543,8 @@ void register_studies(py::module_& m) {
         "worse_than_report_profile, runs, seed).\n"
         "Units: the optimiser's numbers, as `abuopt optimize` prints and archives them: objective and\n"
         "metrics per docs/optimize.md (mean I_r in 1e-7 kg m, %MI in %; objective_label says which),\n"
-        "x in Hz and s. Ctrl-C stops after the current evaluation and raises KeyboardInterrupt.");
+        "x in Hz and s. Ctrl-C stops within the current evaluation (not recorded; those before stay in\n"
+        "the archive) and raises KeyboardInterrupt.");
   m.def("sweep", &sweep, py::arg("config"), py::kw_only(), py::arg("out") = py::none(),
         py::arg("threads") = py::none(), py::arg("seed") = py::none(), py::arg("runs") = py::none(),
         "The design sweep of `abuopt sweep CONFIG` (the config's `sweep` section; docs/sweep.md): every\n"
@@ -547,7 +556,7 @@ void register_studies(py::module_& m) {
         "swept, best (row of the lowest feasible objective, or None), computed, archive_hits, failed,\n"
         "objective_label, problem_id, archive, out.\n"
         "Units: the optimiser's numbers (mean I_r in 1e-7 kg m; docs/optimize.md), x in Hz and s.\n"
-        "Ctrl-C stops after the current point and raises KeyboardInterrupt.");
+        "Ctrl-C stops within the current point (not recorded) and raises KeyboardInterrupt.");
   m.def("pareto", &pareto, py::arg("config"), py::kw_only(), py::arg("out") = py::none(),
         py::arg("threads") = py::none(), py::arg("seed") = py::none(), py::arg("runs") = py::none(),
         py::arg("max_evaluations") = py::none(), py::arg("validate") = true,
@@ -560,7 +569,7 @@ void register_studies(py::module_& m) {
         "dominated), evaluations, starts (arrays), kept_start, reason, problem_ids (lists),\n"
         "report_profile {startup_time_s, in_sample, out_of_sample}, objective_label, archive, out.\n"
         "Units: the optimiser's numbers (mean I_r in 1e-7 kg m; docs/optimize.md), x in Hz and s.\n"
-        "Ctrl-C stops after the current evaluation and raises KeyboardInterrupt.");
+        "Ctrl-C stops within the current evaluation and raises KeyboardInterrupt.");
 }
 
 }  // namespace abuopt::python
