@@ -109,3 +109,118 @@ class Archive:
     def history(self, problem: str = "", *, where: Sequence[str] = ()) -> dict[str, Any]: ...
     def best(self, problem: str = "", *, where: Sequence[str] = ()) -> Optional[dict[str, Any]]: ...
     def evaluation(self, id: int, problem: str = "") -> dict[str, Any]: ...
+
+class _Result(dict[str, Any]):
+    """A dict whose keys are also attributes (r.x == r["x"]), as scipy.optimize.OptimizeResult."""
+    def __getattr__(self, name: str) -> Any: ...
+
+class OptimizeResult(_Result):
+    x: FloatArray  # the best design [Hz, s], in the order of `names`
+    fun: float  # its objective (the optimiser's units: mean I_r in 1e-7 kg m; objective_label)
+    names: list[str]
+    constraints: FloatArray  # g(x), feasible when <= 0
+    constraint_names: list[str]
+    feasible: bool
+    maxcv: float
+    metrics: dict[str, float]
+    success: bool
+    reason: str
+    message: str
+    nfev: int
+    archive_hits: int
+    failed_evaluations: int
+    gradient_evaluations: int
+    wall_time_s: float
+    algorithm: str
+    problem_id: str
+    objective_label: str
+    x0: FloatArray
+    profile: Optional[dict[str, Any]]
+    archive: Optional[str]  # out/archive.sqlite, or None (in memory)
+    out: Optional[str]
+    history: dict[str, Any]  # x (nfev, d), objective, max_violation, best_feasible, ok, feasible, ... arrays
+    validation: Optional[dict[str, Any]]
+
+class SweepResult(_Result):
+    method: str
+    names: list[str]
+    swept: list[str]
+    x: FloatArray  # (points, variables) [Hz, s]
+    unit: FloatArray  # (points, swept) in [0, 1]
+    objective: FloatArray
+    objective_hw95: FloatArray
+    objective_label: str
+    constraints: FloatArray  # (points, constraints)
+    constraint_names: list[str]
+    max_violation: FloatArray
+    ok: npt.NDArray[np.bool_]
+    feasible: npt.NDArray[np.bool_]
+    from_archive: npt.NDArray[np.bool_]
+    metrics: dict[str, FloatArray]
+    wall_time_s: FloatArray
+    message: list[str]
+    best: Optional[int]
+    computed: int
+    archive_hits: int
+    failed: int
+    problem_id: str
+    archive: Optional[str]
+    out: Optional[str]
+
+class ParetoResult(_Result):
+    max_startup_time_s: FloatArray  # the bounds, ascending [s]
+    startup_time_s: FloatArray
+    names: list[str]
+    x: FloatArray  # (bounds, variables)
+    objective: FloatArray
+    objective_hw95: FloatArray
+    objective_label: str
+    out_of_sample_objective: FloatArray
+    out_of_sample_hw95: FloatArray
+    pct_mi: FloatArray
+    out_of_sample_pct_mi: FloatArray
+    feasible: npt.NDArray[np.bool_]
+    dominated: npt.NDArray[np.bool_]
+    front: npt.NDArray[np.bool_]
+    evaluations: npt.NDArray[np.int_]
+    starts: npt.NDArray[np.int_]
+    kept_start: list[str]
+    reason: list[str]
+    problem_ids: list[str]
+    report_profile: dict[str, Any]
+    archive: Optional[str]
+    out: Optional[str]
+
+def optimize(
+    config: Config,
+    *,
+    max_evaluations: Optional[int] = None,
+    out: Optional[Union[str, os.PathLike]] = None,
+    threads: Optional[int] = None,
+    seed: Optional[int] = None,
+    runs: Optional[int] = None,
+    validate: bool = True,
+) -> OptimizeResult:
+    """As `abuopt optimize`: the best design x [Hz, s], fun (mean I_r in 1e-7 kg m), constraints, nfev, archive."""
+
+def sweep(
+    config: Config,
+    *,
+    out: Optional[Union[str, os.PathLike]] = None,
+    threads: Optional[int] = None,
+    seed: Optional[int] = None,
+    runs: Optional[int] = None,
+) -> SweepResult:
+    """As `abuopt sweep`: one row per point (x, objective, constraints, feasible, metrics)."""
+
+def pareto(
+    config: Config,
+    *,
+    out: Optional[Union[str, os.PathLike]] = None,
+    threads: Optional[int] = None,
+    seed: Optional[int] = None,
+    runs: Optional[int] = None,
+    max_evaluations: Optional[int] = None,
+    validate: bool = True,
+) -> ParetoResult:
+    """As `abuopt pareto`: one row per bound on the startup time; `front` marks the Pareto front."""

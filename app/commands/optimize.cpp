@@ -33,6 +33,7 @@
 #include "abuopt/optimizer/penalty_problem.hpp"
 #include "abuopt/parallel/parallel.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
+#include "abuopt/studies/optimize_run.hpp"
 #include "abuopt/studies/out_of_sample.hpp"
 #include "abuopt/studies/sweep.hpp"
 #include "abuopt/studies/terms.hpp"
@@ -224,34 +225,30 @@ void write_best_profile(const fs::path& path, const StartupProfileProblem& probl
 
 int run_optimize(const OptimizeArgs& a) {
   LoadedConfig cfg = load_config(a);
-  StartupProfileProblem problem(cfg.settings);
+  // The problem and its penalty form when constraints.penalty_weight > 0 (what the optimiser sees),
+  // later the archive in front of it: studies/optimize_run.hpp (abuopt.optimize runs the same).
+  OptimizeRun run(cfg.settings, cfg.options);
+  StartupProfileProblem& problem = run.problem();
   const auto& st = problem.settings();
   // under mpirun every Monte Carlo (the evaluations and the validation) is spread over the ranks,
   // and a batch of independent evaluations (SAO's design, finite-difference neighbours) runs as
   // concurrent studies whose runs share the ranks (docs/cluster.md, "Batches of evaluations")
   if (parallel::session() && parallel::session()->size() > 1) {
     problem.set_monte_carlo_runner(parallel::make_runner(st.threads), parallel::session()->concurrent_studies());
-    cfg.options.scheduler = parallel::make_evaluation_scheduler();
+    run.options().scheduler = parallel::make_evaluation_scheduler();
   }
-  // What the optimiser sees: the problem, or its penalty form (constraints.penalty_weight > 0).
-  std::optional<opt::PenaltyProblem> penalised;
-  if (st.constraints.penalty_weight > 0) penalised.emplace(problem, st.constraints.penalty_weight);
-  opt::Problem& optimised = penalised ? static_cast<opt::Problem&>(*penalised) : problem;
   const std::vector<opt::Variable> vars = problem.variables();
-  const std::vector<std::string> g_names = optimised.inequality_names();
+  const std::vector<std::string> g_names = run.optimised().inequality_names();
 
   const fs::path out = a.out.empty() ? fs::path("results") / fs::path(a.config).stem() : fs::path(a.out);
   const OutputDirLock lock(out);  // creates it; one run per output directory
   const std::string id = problem.identity();
-  opt::EvaluationArchive archive((out / "archive.sqlite").string(), id);
   const Provenance prov = provenance_of(a.config);
-  archive.record_metadata("optimize", a.config, prov.config_hash);
-  opt::ArchivedProblem archived(optimised, archive);
-  cfg.options.sao.archive = &archive;  // SAO: archived points inform its surrogates
+  run.open_archive((out / "archive.sqlite").string(), "optimize", a.config, prov.config_hash);
 
   // Progress to stdout, or to stderr with --json (stdout then holds the JSON alone).
   std::ostream& log = a.json ? std::cerr : std::cout;
-  const long stored = archive.count();
+  const long stored = run.stored_at_start();
   log << "optimize " << a.config << ": problem " << id << ", " << vars.size() << " variables, "
       << g_names.size() << " constraints, algorithm " << cfg.options.algorithm << ", budget "
       << cfg.options.max_evaluations << " evaluations\n"
@@ -296,7 +293,7 @@ int run_optimize(const OptimizeArgs& a) {
   };
 
   const StopScope stop_scope;  // SIGINT / SIGTERM end the run after the current evaluation's runs
-  opt::OptimizationResult r = opt::minimize(archived, cfg.options, {}, progress);
+  opt::OptimizationResult r = run.minimize(progress);
   bar.finish();
   log << "\n" << r.brief_report() << "\n";
   if (!r.message.empty()) log << "  " << r.message << "\n";
@@ -386,7 +383,7 @@ int run_optimize(const OptimizeArgs& a) {
     log << "\nvalidation: " << v.runs << " fresh initial conditions (" << to_string(v.design) << ", seed " << v.seed
         << ") for the best design and for the report's final profile ...\n"
         << std::flush;
-    const OutOfSampleComparison cmp = compare_out_of_sample(problem, r, penalised ? &*penalised : nullptr);
+    const OutOfSampleComparison cmp = run.compare_out_of_sample(r);
     const StartupProfile& report = cmp.report;
     const std::vector<ComparisonRow>& rows = cmp.rows;
     const OutOfSampleVerdict verdict = out_of_sample_verdict(rows);

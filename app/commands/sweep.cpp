@@ -120,10 +120,7 @@ int run_sweep_command(const SweepArgs& a) {
   write_sweep_csv(out / "sweep.csv", problem, r);
   const std::vector<std::string> plots = write_sweep_plots(out, problem, r);
 
-  // Best feasible point of the sweep (lowest objective).
-  const SweepPoint* best = nullptr;
-  for (const auto& p : r.points)
-    if (p.feasible && (!best || p.e.objective < best->e.objective)) best = &p;
+  const SweepPoint* best = best_feasible_point(r);
 
   nlohmann::json j;
   j["config"] = a.config;

@@ -12,4 +12,7 @@ void register_module_extras(pybind11::module_& m);
 // abuopt.Archive: reading an evaluation archive of optimize, sweep and pareto (archive_bindings.cpp).
 void register_archive(pybind11::module_& m);
 
+// abuopt.optimize, abuopt.sweep, abuopt.pareto and their result types (study_bindings.cpp).
+void register_studies(pybind11::module_& m);
+
 }  // namespace abuopt::python

@@ -370,6 +370,7 @@ PYBIND11_MODULE(abuopt, m) {
       "1e-7 kg m; docs/optimize.md). Per-run results are NumPy arrays.";
   py::register_exception<abuopt::ConfigError>(m, "ConfigError", PyExc_ValueError);
   register_archive(m);  // abuopt.Archive (archive_bindings.cpp)
+  register_studies(m);  // abuopt.optimize, sweep, pareto (study_bindings.cpp)
 
   m.def("simulate", &simulate, py::arg("config"), py::kw_only(), py::arg("beta0"),
         "One startup from the initial ball angles beta0 [rad] (one per ball), as `abuopt simulate`.\n"

@@ -62,6 +62,14 @@ void mark_dominated(std::vector<ParetoPoint>& points) {
   }
 }
 
+namespace {
+// The run was stopped from outside (Ctrl-C, request_stop, a progress callback that returned false):
+// the series stops with it.
+bool stopped(opt::TerminationReason r) {
+  return r == opt::TerminationReason::Interrupted || r == opt::TerminationReason::StoppedByCallback;
+}
+}  // namespace
+
 ParetoResult run_pareto(const problems::StartupProfileSettings& base, const opt::OptimizerOptions& options,
                         const ParetoSettings& pareto, const std::string& archive_path,
                         const std::string& command_config, const std::string& config_hash,
@@ -91,19 +99,19 @@ ParetoResult run_pareto(const problems::StartupProfileSettings& base, const opt:
     p.result = opt::minimize(archived, options, {}, cb);
     p.evaluations = p.result.evaluations;
     p.starts = 1;
-    if (pareto.warm_start && !start.empty() && p.result.reason != opt::TerminationReason::Interrupted) {
+    if (pareto.warm_start && !start.empty() && !stopped(p.result.reason)) {
       opt::OptimizationResult warm = opt::minimize(archived, options, start, cb);
       p.evaluations += warm.evaluations;
       p.starts = 2;
       const bool better = warm.feasible && (!p.result.feasible || warm.objective < p.result.objective);
       p.warm_start_won = better;
-      if (better || warm.reason == opt::TerminationReason::Interrupted) p.result = std::move(warm);
+      if (better || stopped(warm.reason)) p.result = std::move(warm);
     }
     p.x = p.result.x;
     if (!p.x.empty()) p.startup_time_s = problem.startup_time_s(p.x);
     if (p.result.feasible) start = p.x;  // feasible for every looser bound that follows
     out.points.push_back(std::move(p));
-    if (out.points.back().result.reason == opt::TerminationReason::Interrupted) {
+    if (stopped(out.points.back().result.reason)) {
       out.interrupted = true;
       break;
     }

@@ -167,6 +167,13 @@ SweepPlan plan_sweep(const SweepSettings& s, const std::vector<opt::Variable>& v
   return plan;
 }
 
+const SweepPoint* best_feasible_point(const SweepResult& r) {
+  const SweepPoint* best = nullptr;
+  for (const auto& p : r.points)
+    if (p.feasible && (!best || p.e.objective < best->e.objective)) best = &p;
+  return best;
+}
+
 SweepResult run_sweep(opt::Problem& problem, opt::EvaluationArchive& archive, const SweepPlan& plan,
                       const SweepProgress& progress, const std::atomic<bool>* stop, double constraint_tolerance) {
   using clock = std::chrono::steady_clock;

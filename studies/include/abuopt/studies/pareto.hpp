@@ -60,11 +60,12 @@ struct ParetoResult {
   opt::Evaluation report_in_sample;      // the report's final profile
   opt::Evaluation report_out_of_sample;
   double report_startup_time_s = 0;
-  bool interrupted = false;
+  bool interrupted = false;              // Ctrl-C / request_stop / the progress callback stopped it
 };
 
 // Called after every evaluation of every run: the bound being solved (index, count) and the
-// optimiser's progress. Return false to stop (as an EvaluationCallback).
+// optimiser's progress. Return false to stop the series (as an EvaluationCallback; no further
+// bound is solved, no validation, `interrupted` is set).
 using ParetoProgress = std::function<bool(std::size_t, std::size_t, const opt::Progress&)>;
 
 // Solves every bound (archive at archive_path, shared by all of them; problem ids differ), then,

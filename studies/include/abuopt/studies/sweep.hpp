@@ -83,6 +83,9 @@ struct SweepResult {
   double wall_time_s = 0;
 };
 
+// The feasible point with the lowest objective (the first of equals), or null when none is feasible.
+const SweepPoint* best_feasible_point(const SweepResult& r);
+
 // Called after every point: the point, points done, points planned, elapsed seconds.
 using SweepProgress = std::function<void(const SweepPoint&, std::size_t, std::size_t, double)>;
 
