@@ -330,3 +330,15 @@ void write_runs_csv(std::ostream& os, const std::vector<MonteCarloSample>& sampl
 }
 
 }  // namespace abuopt
+
+namespace abuopt {
+
+nlohmann::json to_json(const MonteCarloStats& s, const MonteCarloResult& result, const MonteCarloStudy& study) {
+  nlohmann::json j = to_json(s);
+  const IntervalLayout layout = interval_layout(study);
+  j["magnitude"]["mean_ci95_half_width"] = mean_half_width95(result.samples, layout);
+  j["report_x"]["mean_ci95_half_width"] = mean_half_width95(result.samples, layout, true);
+  return j;
+}
+
+}  // namespace abuopt

@@ -222,7 +222,7 @@ py::dict montecarlo(const py::handle& config, std::optional<long long> runs, std
   d["steps"] = steps;
   d["rhs_evaluations"] = rhs;
   d["wall_time_s"] = wall;
-  d["summary"] = to_python(to_json(stats));
+  d["summary"] = to_python(to_json(stats, result, cfg.study));
   return d;
 }
 

@@ -98,6 +98,10 @@ double mean_half_width95(const std::vector<MonteCarloSample>& samples, const Int
 // p90, p95, mi_count, pct_mi, pct_mi_ci95 [lo, hi]), settling_time_s {settled, mean, median, max},
 // max_amplitude_mm {max, mean}, quantile_definition. NaN becomes null.
 nlohmann::json to_json(const MonteCarloStats& s);
+// The same with the 95 % half-width of each mean from the study's sampling layout
+// (magnitude.mean_ci95_half_width, report_x.mean_ci95_half_width): what `abuopt montecarlo --json`
+// and the Python module's summary print.
+nlohmann::json to_json(const MonteCarloStats& s, const MonteCarloResult& result, const MonteCarloStudy& study);
 
 // Human-readable multi-line summary (both definitions, kg m in units of 1e-7 as in the report).
 std::string format_summary(const MonteCarloStats& s);
