@@ -343,6 +343,72 @@ TEST(EnvelopeSimulator, RunsWithTheirOwnOscillatorStayOnTheExactPath) {
   EXPECT_LT(2 * rhs_view, rhs_rk);
 }
 
+TEST(EnvelopeSimulator, AZeroImbalanceMassRunsUnderBothMassKeys) {
+  // abu.imbalance_mass_kg may be 0 (the abu rule is >= 0): m_I x factor and m_I (1 + u) are then 0,
+  // an override the simulator must accept as it accepts the nominal 0 (it threw
+  // std::invalid_argument, aborting the study). A balanced rotor with balls at 0 and pi stays
+  // balanced to 1e-9 kg m.
+  for (bool old_key : {false, true}) {
+    MonteCarloStudy s = envelope_study(4);
+    s.setup.abu.imbalance_mass_kg = 0.0;
+    s.setup.profile = StartupProfile({{60.0, 2.0}});
+    s.setup.options.end_time_s = 3.0;
+    if (old_key) {
+      s.uncertain.envelope.imbalance_mass_factor = {};
+      s.uncertain.imbalance_mass.sampling = ImbalanceMassSampling::RelativeRange;
+      s.uncertain.imbalance_mass.relative_lo = -0.5;
+      s.uncertain.imbalance_mass.relative_hi = 0.5;
+    }
+    ThreadPoolRunner one(1);
+    MonteCarloResult r;
+    ASSERT_NO_THROW(r = run_monte_carlo(s, one)) << (old_key ? "mass_relative_range" : "imbalance_mass_factor");
+    ASSERT_EQ(r.samples.size(), 4u);
+    for (const auto& smp : r.samples) {
+      EXPECT_EQ(*smp.overrides.imbalance_mass_kg, 0.0);
+      EXPECT_TRUE(smp.outcome.ok()) << smp.outcome.message;
+    }
+    RunOverrides zero;
+    zero.imbalance_mass_kg = 0.0;
+    const RunOutcome balanced = Simulator(s.setup).run({0.0, M_PI}, zero);
+    EXPECT_NEAR(balanced.residual_imbalance_kgm, 0.0, 1e-9);
+  }
+}
+
+TEST(EnvelopeConfig, FactorsMustKeepTheAbuRules) {
+  // nominal x [lo, hi] must obey the abu section's rules (stiffness <= 1e9 N/m, imbalance mass <=
+  // 1e4 kg): a ConfigError naming the key, not an exception from the simulator mid-study.
+  auto error = [](MonteCarloStudy s) -> std::string {
+    try {
+      validate(s);
+    } catch (const ConfigError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  MonteCarloStudy s = envelope_study(8);
+  EXPECT_EQ(error(s), "no error");
+  s.setup.abu.stiffness_N_per_m = 5e8;
+  s.uncertain.envelope.stiffness_factor = ParameterDistribution::uniform(1.0, 3.0);
+  const std::string k = error(s);
+  EXPECT_NE(k.find("envelope.stiffness_factor"), std::string::npos) << k;
+  EXPECT_NE(k.find("1.5e+09"), std::string::npos) << k;
+  s = envelope_study(8);
+  s.setup.abu.imbalance_mass_kg = 5e3;
+  s.uncertain.envelope.imbalance_mass_factor = ParameterDistribution::fixed(4.0);
+  const std::string m = error(s);
+  EXPECT_NE(m.find("envelope.imbalance_mass_factor"), std::string::npos) << m;
+  s = envelope_study(8);
+  s.setup.abu.imbalance_mass_kg = 5e3;
+  s.uncertain.envelope.imbalance_mass_factor = {};
+  s.uncertain.imbalance_mass.sampling = ImbalanceMassSampling::RelativeRange;
+  s.uncertain.imbalance_mass.relative_lo = 0.0;
+  s.uncertain.imbalance_mass.relative_hi = 2.0;
+  const std::string r = error(s);
+  EXPECT_NE(r.find("montecarlo.imbalance.mass_relative_range"), std::string::npos) << r;
+  s.uncertain.imbalance_mass.relative_hi = 0.5;  // 7500 kg: inside the rule
+  EXPECT_EQ(error(s), "no error");
+}
+
 TEST(EnvelopeSimulator, StiffnessMovesTheResonance) {
   // Balls held by friction (mu 0.9): the table is a forced oscillator. On a slow ramp (25 -> 35 Hz
   // in 40 s, at most 0.5 Hz/s) its amplitude peaks just after the natural frequency (within
