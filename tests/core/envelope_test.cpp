@@ -172,6 +172,17 @@ TEST(EnvelopeDraws, UseTheStreamsOfTheOldKeys) {
     EXPECT_NEAR(*a.imbalance_mass_kg, *b.imbalance_mass_kg, 1e-15 * *a.imbalance_mass_kg);
     EXPECT_FALSE(a.stiffness_N_per_m.has_value());
   }
+  // The default sampling, stratified, moves run i's draw into its cell ((bit + u) / 2): the same
+  // distribution, other draws (envelope.hpp says so; about half the runs change, none may stay all).
+  MonteCarloStudy stratified = envelope_study(64);
+  ASSERT_EQ(stratified.uncertain.envelope.sampling, EnvelopeSampling::Stratified);
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < 64; ++i) {
+    const RunOverrides a = sample_overrides(old_keys.uncertain, old_keys.setup.abu, 7, i);
+    const RunOverrides b = sample_overrides(stratified.uncertain, stratified.setup.abu, 7, i);
+    if (*a.friction_mu != *b.friction_mu) ++differ;
+  }
+  EXPECT_GT(differ, 16u);
 }
 
 TEST(EnvelopeDraws, SobolSamplingStratifiesEveryReplicateAndGivesTheAngles) {
