@@ -7,6 +7,7 @@
 #include <numeric>
 
 #include "abuopt/common/stop.hpp"
+#include "abuopt/common/text.hpp"
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/core/ball_contact.hpp"
 
@@ -102,6 +103,39 @@ InitialConditionDesign study_design(const MonteCarloStudy& s) {
   return d;
 }
 
+namespace {
+
+// The values a study's factors give, nominal x [lo, hi], must obey the abu section's own rules
+// (stiffness in (0, kStiffnessNPerM], imbalance mass in [0, kMassKg]): Simulator::run rejects an
+// override outside them with std::invalid_argument, which would abort the study part-way.
+void validate_override_ranges(const MonteCarloStudy& s, const std::string& path) {
+  const AbuParameters& abu = s.setup.abu;
+  auto check = [](const std::string& key, const std::string& value, double nominal, double lo, double hi,
+                  bool zero_ok, double limit, const std::string& what) {
+    const double a = nominal * lo, b = nominal * hi;
+    const bool ok = std::isfinite(a) && std::isfinite(b) && (zero_ok ? a >= 0 : a > 0) && b <= limit;
+    if (!ok)
+      throw ConfigError(key, value,
+                        "gives " + what + " in [" + format_number(a) + ", " + format_number(b) + "] (nominal " + format_number(nominal) +
+                            "), which must lie in " + (zero_ok ? "[0, " : "(0, ") + format_number(limit) +
+                            "] as the abu section requires");
+  };
+  const Envelope& e = s.uncertain.envelope;
+  if (e.stiffness_factor.given())
+    check("envelope.stiffness_factor", e.stiffness_factor.text(), abu.stiffness_N_per_m, e.stiffness_factor.lo,
+          e.stiffness_factor.hi, false, AbuLimits::kStiffnessNPerM, "a stiffness (N/m)");
+  if (e.imbalance_mass_factor.given())
+    check("envelope.imbalance_mass_factor", e.imbalance_mass_factor.text(), abu.imbalance_mass_kg,
+          e.imbalance_mass_factor.lo, e.imbalance_mass_factor.hi, true, AbuLimits::kMassKg, "an imbalance mass (kg)");
+  const ImbalanceMassUncertainty& m = s.uncertain.imbalance_mass;
+  if (m.sampling == ImbalanceMassSampling::RelativeRange)
+    check((path.empty() ? "" : path + ".") + "imbalance.mass_relative_range",
+          "[" + format_number(m.relative_lo) + ", " + format_number(m.relative_hi) + "]", abu.imbalance_mass_kg, 1.0 + m.relative_lo,
+          1.0 + m.relative_hi, true, AbuLimits::kMassKg, "an imbalance mass (kg)");
+}
+
+}  // namespace
+
 void validate(const MonteCarloStudy& s, const std::string& path) {
   const std::string p = path.empty() ? "" : path + ".";
   if (s.setup.abu.balls.empty()) throw ConfigError("abu.balls", "[]", "must hold at least one ball for a Monte Carlo");
@@ -124,6 +158,7 @@ void validate(const MonteCarloStudy& s, const std::string& path) {
     throw ConfigError("envelope.sampling", "sobol",
                       "draws the start angles of at most 6 balls (the Sobol' directions cover 10 dimensions); "
                       "use sampling: random, or a montecarlo.design other than random/sobol");
+  validate_override_ranges(s, path);
   if (s.uncertain.envelope.restitution.given() && s.setup.abu.ball_contact != BallContact::Hard)
     throw ConfigError("envelope.restitution", s.uncertain.envelope.restitution.text(),
                       "needs abu.ball_contact: hard (restitution is the ball-ball impacts' coefficient)");

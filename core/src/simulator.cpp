@@ -489,9 +489,10 @@ RunOutcome Simulator::run(const std::vector<double>& beta0, const RunOverrides& 
     throw std::invalid_argument("Simulator::run: the ABU has " + std::to_string(setup_.abu.balls.size()) +
                                 " balls, but " + std::to_string(beta0.size()) + " initial angles were given");
   if ((ov.stiffness_N_per_m && !(*ov.stiffness_N_per_m > 0 && std::isfinite(*ov.stiffness_N_per_m))) ||
-      (ov.imbalance_mass_kg && !(*ov.imbalance_mass_kg > 0 && std::isfinite(*ov.imbalance_mass_kg))) ||
+      (ov.imbalance_mass_kg && !(*ov.imbalance_mass_kg >= 0 && std::isfinite(*ov.imbalance_mass_kg))) ||
       (ov.ball_restitution && !(*ov.ball_restitution >= 0 && *ov.ball_restitution <= 1)))
-    throw std::invalid_argument("Simulator::run: an override is out of range (stiffness and imbalance mass > 0, "
+    // the abu section's rules: stiffness > 0, imbalance mass >= 0 (a balanced rotor is a valid ABU)
+    throw std::invalid_argument("Simulator::run: an override is out of range (stiffness > 0, imbalance mass >= 0, "
                                 "restitution in [0, 1])");
   Run run(setup_, end_time_s(), beta0, ov, trajectory, stuck_table_.get(), reference_ ? *reference_ : setup_.profile);
   RunOutcome out = run.execute();

@@ -73,11 +73,11 @@ ArchiveReader::ArchiveReader(const std::string& path) : path_(path) {
     throw ConfigError("archive", path, "no such file (an archive.sqlite written by optimize, sweep or pareto)");
   std::vector<EvaluationArchive::ProblemRecord> records;
   {
-    EvaluationArchive any(path, "");
+    EvaluationArchive any(path, "", EvaluationArchive::OpenMode::ReadOnly);
     records = any.problems();
   }
   for (auto& rec : records) {
-    EvaluationArchive a(path, rec.problem_id);
+    EvaluationArchive a(path, rec.problem_id, EvaluationArchive::OpenMode::ReadOnly);
     a.set_warning_handler({});  // damaged rows are left out and counted
     ArchiveProblem p;
     p.evaluations = a.entries();

@@ -3,10 +3,12 @@
 #include <sqlite3.h>
 
 #include <chrono>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <ctime>
+#include <filesystem>
 #include <iostream>
 #include <stdexcept>
 
@@ -109,6 +111,23 @@ std::string row_checksum(const std::string& problem_id, const std::string& x_key
 bool is_corruption(int rc) { return (rc & 0xff) == SQLITE_CORRUPT || (rc & 0xff) == SQLITE_NOTADB; }
 // The file cannot be written (disk full, a file-size limit, no permission, read-only): an output
 // failure like any other file's (OutputError: exit status 4), not a failed computation.
+// "file:/abs/path?immutable=1": a read-only WAL archive in a directory the reader cannot write
+// (no -shm can be created beside it) is readable only as immutable.
+std::string immutable_uri(const std::string& path) {
+  std::string out = "file:";
+  for (const unsigned char c : std::filesystem::absolute(path).string()) {
+    if (std::isalnum(c) || std::strchr("/-._~", c)) {
+      out += static_cast<char>(c);
+    } else {
+      static const char* hex = "0123456789ABCDEF";
+      out += '%';
+      out += hex[c >> 4];
+      out += hex[c & 15];
+    }
+  }
+  return out + "?immutable=1";
+}
+
 bool is_write_failure(int rc) {
   const int p = rc & 0xff;
   return p == SQLITE_FULL || p == SQLITE_IOERR || p == SQLITE_READONLY || p == SQLITE_CANTOPEN || p == SQLITE_PERM;
@@ -211,16 +230,34 @@ std::optional<Evaluation> intact_evaluation_of(const Statement& s, int first, co
 
 std::string EvaluationArchive::key_of(const std::vector<double>& x) { return hex_of(x); }
 
-EvaluationArchive::EvaluationArchive(const std::string& path, std::string problem_id)
-    : path_(path), problem_id_(std::move(problem_id)) {
-  if (const int rc = sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,
-                                     nullptr);
-      rc != SQLITE_OK) {
+EvaluationArchive::EvaluationArchive(const std::string& path, std::string problem_id, OpenMode mode)
+    : path_(path), problem_id_(std::move(problem_id)), read_only_(mode == OpenMode::ReadOnly) {
+  const int flags = read_only_ ? SQLITE_OPEN_READONLY | SQLITE_OPEN_FULLMUTEX
+                               : SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX;
+  if (const int rc = sqlite3_open_v2(path.c_str(), &db_, flags, nullptr); rc != SQLITE_OK) {
     const std::string why = db_ ? sqlite3_errmsg(db_) : "out of memory";
     sqlite3_close(db_);
     db_ = nullptr;
     if (is_write_failure(rc)) throw OutputError("cannot write the evaluation archive " + path + ": " + why);
     throw ConfigError("evaluation archive '" + path + "' cannot be opened: " + why);
+  }
+  if (read_only_ && !std::filesystem::exists(path + "-wal")) {
+    // A WAL archive opened read-only needs its -shm file, which a read-only directory cannot hold:
+    // the first read fails (SQLITE_READONLY / SQLITE_CANTOPEN). With no -wal file beside it no writer
+    // is active and the file alone is the archive: it is then read as immutable.
+    const int rc = sqlite3_exec(db_, "SELECT COUNT(*) FROM sqlite_master", nullptr, nullptr, nullptr) & 0xff;
+    if (rc == SQLITE_READONLY || rc == SQLITE_CANTOPEN) {
+      sqlite3_close(db_);
+      db_ = nullptr;
+      if (const int rc2 = sqlite3_open_v2(immutable_uri(path).c_str(), &db_,
+                                          SQLITE_OPEN_READONLY | SQLITE_OPEN_URI | SQLITE_OPEN_FULLMUTEX, nullptr);
+          rc2 != SQLITE_OK) {
+        const std::string why = db_ ? sqlite3_errmsg(db_) : "out of memory";
+        sqlite3_close(db_);
+        db_ = nullptr;
+        throw ConfigError("evaluation archive '" + path + "' cannot be opened: " + why);
+      }
+    }
   }
   sqlite3_busy_timeout(db_, 10000);
   try {
@@ -248,6 +285,14 @@ EvaluationArchive::EvaluationArchive(const std::string& path, std::string proble
                         "; this abuopt reads version " + std::to_string(kSchemaVersion) +
                         " (checksums and run counts per evaluation): move it away or delete it (its evaluations "
                         "are recomputed)");
+    if (read_only_) {
+      if (!existing)
+        throw ConfigError("archive", path_,
+                          "is not an evaluation archive (no evaluations table: an empty or foreign file; "
+                          "archives are written by optimize, sweep or pareto)");
+      warn_ = [](const std::string& w) { std::cerr << "warning: " << w << "\n"; };
+      return;  // a reader writes nothing: no journal mode, no schema
+    }
     exec("PRAGMA journal_mode=WAL");
     exec("PRAGMA synchronous=NORMAL");
     // The schema (three tables and the version) in one transaction: a process killed while it
@@ -314,9 +359,11 @@ void EvaluationArchive::set_warning_handler(std::function<void(const std::string
 }
 
 void EvaluationArchive::discard_damaged(long id, const std::string& what) const {
-  Statement d(db_, path_, "DELETE FROM evaluations WHERE id = ?1");
-  d.bind_int(1, id);
-  d.step();
+  if (!read_only_) {  // a reader leaves the file as it is: the row is only left out
+    Statement d(db_, path_, "DELETE FROM evaluations WHERE id = ?1");
+    d.bind_int(1, id);
+    d.step();
+  }
   ++damaged_;
   if (warn_)
     warn_("evaluation archive '" + path_ + "': stored evaluation #" + std::to_string(id) +
@@ -488,6 +535,11 @@ void EvaluationArchive::record_metadata(const std::string& command, const std::s
 
 std::vector<EvaluationArchive::Metadata> EvaluationArchive::metadata() const {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (read_only_) {  // an archive older than the metadata table: a writer adds it, a reader finds none
+    Statement t(db_, path_, "SELECT COUNT(*) FROM sqlite_master WHERE type = 'table' AND name = 'metadata'");
+    t.step();
+    if (t.integer(0) == 0) return {};
+  }
   Statement s(db_, path_,
               "SELECT id, problem_id, timestamp, abuopt_version, git_commit, command, config, config_hash"
               " FROM metadata WHERE problem_id = ?1 ORDER BY id");

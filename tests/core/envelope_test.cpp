@@ -172,6 +172,17 @@ TEST(EnvelopeDraws, UseTheStreamsOfTheOldKeys) {
     EXPECT_NEAR(*a.imbalance_mass_kg, *b.imbalance_mass_kg, 1e-15 * *a.imbalance_mass_kg);
     EXPECT_FALSE(a.stiffness_N_per_m.has_value());
   }
+  // The default sampling, stratified, moves run i's draw into its cell ((bit + u) / 2): the same
+  // distribution, other draws (envelope.hpp says so; about half the runs change, none may stay all).
+  MonteCarloStudy stratified = envelope_study(64);
+  ASSERT_EQ(stratified.uncertain.envelope.sampling, EnvelopeSampling::Stratified);
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < 64; ++i) {
+    const RunOverrides a = sample_overrides(old_keys.uncertain, old_keys.setup.abu, 7, i);
+    const RunOverrides b = sample_overrides(stratified.uncertain, stratified.setup.abu, 7, i);
+    if (*a.friction_mu != *b.friction_mu) ++differ;
+  }
+  EXPECT_GT(differ, 16u);
 }
 
 TEST(EnvelopeDraws, SobolSamplingStratifiesEveryReplicateAndGivesTheAngles) {
@@ -283,6 +294,44 @@ TEST(EnvelopeDraws, RunOneReplaysAnyRunAndThreadsDoNotMatter) {
   EXPECT_EQ(prepare_sample(shorter, 42).overrides.stiffness_N_per_m, r1.samples[42].overrides.stiffness_N_per_m);
 }
 
+TEST(EnvelopeSimulator, ThreadsAndReplayGiveTheSameRunsWithTheRealSimulator) {
+  // The same check as above with the real Simulator: a stiffness envelope (x U[0.95, 1.05]) makes
+  // the runs take the per-run views of the process-wide forcing-sample cache (run_forcing_table.hpp),
+  // built on first use by whichever worker needs a frequency rung first. A profile no other test
+  // uses, so its rungs are built here, under 3 threads, then reused: every run's final angles,
+  // residual and peak amplitude bitwise equal to 1 thread's, and to run_one's replay of it.
+  MonteCarloStudy s = envelope_study(24);
+  s.setup.profile = StartupProfile({{25.0, 1.0}, {29.5, 2.5}, {47.0, 1.5}});
+  ThreadPoolRunner one(1), three(3);
+  const MonteCarloResult r3 = run_monte_carlo(s, three);
+  const MonteCarloResult r1 = run_monte_carlo(s, one);
+  ASSERT_EQ(r3.samples.size(), 24u);
+  ASSERT_EQ(r1.samples.size(), 24u);
+  std::size_t stiffness_overridden = 0;
+  for (std::size_t i = 0; i < 24; ++i) {
+    const RunOutcome& a = r1.samples[i].outcome;
+    const RunOutcome& b = r3.samples[i].outcome;
+    ASSERT_TRUE(a.ok() && b.ok()) << a.message << b.message;
+    EXPECT_EQ(a.beta_final, b.beta_final) << "run " << i;
+    EXPECT_EQ(a.residual_imbalance_kgm, b.residual_imbalance_kgm) << "run " << i;
+    EXPECT_EQ(a.max_amplitude_mm, b.max_amplitude_mm) << "run " << i;
+    if (r1.samples[i].overrides.stiffness_N_per_m &&
+        *r1.samples[i].overrides.stiffness_N_per_m != s.setup.abu.stiffness_N_per_m)
+      ++stiffness_overridden;
+  }
+  EXPECT_EQ(stiffness_overridden, 24u);
+  // the runs differ from each other (the comparison is not of 24 copies of one number)
+  std::vector<double> residuals;
+  for (const auto& smp : r1.samples) residuals.push_back(smp.outcome.residual_imbalance_kgm);
+  std::sort(residuals.begin(), residuals.end());
+  EXPECT_GT(std::unique(residuals.begin(), residuals.end()) - residuals.begin(), 12);
+  for (std::size_t i : {0u, 11u, 23u}) {
+    const MonteCarloSample replay = run_one(s, i);
+    EXPECT_EQ(replay.outcome.beta_final, r1.samples[i].outcome.beta_final) << "run " << i;
+    EXPECT_EQ(replay.outcome.residual_imbalance_kgm, r1.samples[i].outcome.residual_imbalance_kgm) << "run " << i;
+  }
+}
+
 TEST(EnvelopeSimulator, AnOverrideEqualsTheNominalRunWithThatValue) {
   // Each drawn parameter reaches the simulator: run i with its overrides gives what a setup with
   // those values as nominal gives (same path: the Runge-Kutta stuck phases for both).
@@ -341,6 +390,72 @@ TEST(EnvelopeSimulator, RunsWithTheirOwnOscillatorStayOnTheExactPath) {
   }
   EXPECT_NEAR(static_cast<double>(steps_view) / static_cast<double>(steps_nominal), 1.0, 0.05);
   EXPECT_LT(2 * rhs_view, rhs_rk);
+}
+
+TEST(EnvelopeSimulator, AZeroImbalanceMassRunsUnderBothMassKeys) {
+  // abu.imbalance_mass_kg may be 0 (the abu rule is >= 0): m_I x factor and m_I (1 + u) are then 0,
+  // an override the simulator must accept as it accepts the nominal 0 (it threw
+  // std::invalid_argument, aborting the study). A balanced rotor with balls at 0 and pi stays
+  // balanced to 1e-9 kg m.
+  for (bool old_key : {false, true}) {
+    MonteCarloStudy s = envelope_study(4);
+    s.setup.abu.imbalance_mass_kg = 0.0;
+    s.setup.profile = StartupProfile({{60.0, 2.0}});
+    s.setup.options.end_time_s = 3.0;
+    if (old_key) {
+      s.uncertain.envelope.imbalance_mass_factor = {};
+      s.uncertain.imbalance_mass.sampling = ImbalanceMassSampling::RelativeRange;
+      s.uncertain.imbalance_mass.relative_lo = -0.5;
+      s.uncertain.imbalance_mass.relative_hi = 0.5;
+    }
+    ThreadPoolRunner one(1);
+    MonteCarloResult r;
+    ASSERT_NO_THROW(r = run_monte_carlo(s, one)) << (old_key ? "mass_relative_range" : "imbalance_mass_factor");
+    ASSERT_EQ(r.samples.size(), 4u);
+    for (const auto& smp : r.samples) {
+      EXPECT_EQ(*smp.overrides.imbalance_mass_kg, 0.0);
+      EXPECT_TRUE(smp.outcome.ok()) << smp.outcome.message;
+    }
+    RunOverrides zero;
+    zero.imbalance_mass_kg = 0.0;
+    const RunOutcome balanced = Simulator(s.setup).run({0.0, M_PI}, zero);
+    EXPECT_NEAR(balanced.residual_imbalance_kgm, 0.0, 1e-9);
+  }
+}
+
+TEST(EnvelopeConfig, FactorsMustKeepTheAbuRules) {
+  // nominal x [lo, hi] must obey the abu section's rules (stiffness <= 1e9 N/m, imbalance mass <=
+  // 1e4 kg): a ConfigError naming the key, not an exception from the simulator mid-study.
+  auto error = [](MonteCarloStudy s) -> std::string {
+    try {
+      validate(s);
+    } catch (const ConfigError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  MonteCarloStudy s = envelope_study(8);
+  EXPECT_EQ(error(s), "no error");
+  s.setup.abu.stiffness_N_per_m = 5e8;
+  s.uncertain.envelope.stiffness_factor = ParameterDistribution::uniform(1.0, 3.0);
+  const std::string k = error(s);
+  EXPECT_NE(k.find("envelope.stiffness_factor"), std::string::npos) << k;
+  EXPECT_NE(k.find("1.5e+09"), std::string::npos) << k;
+  s = envelope_study(8);
+  s.setup.abu.imbalance_mass_kg = 5e3;
+  s.uncertain.envelope.imbalance_mass_factor = ParameterDistribution::fixed(4.0);
+  const std::string m = error(s);
+  EXPECT_NE(m.find("envelope.imbalance_mass_factor"), std::string::npos) << m;
+  s = envelope_study(8);
+  s.setup.abu.imbalance_mass_kg = 5e3;
+  s.uncertain.envelope.imbalance_mass_factor = {};
+  s.uncertain.imbalance_mass.sampling = ImbalanceMassSampling::RelativeRange;
+  s.uncertain.imbalance_mass.relative_lo = 0.0;
+  s.uncertain.imbalance_mass.relative_hi = 2.0;
+  const std::string r = error(s);
+  EXPECT_NE(r.find("montecarlo.imbalance.mass_relative_range"), std::string::npos) << r;
+  s.uncertain.imbalance_mass.relative_hi = 0.5;  // 7500 kg: inside the rule
+  EXPECT_EQ(error(s), "no error");
 }
 
 TEST(EnvelopeSimulator, StiffnessMovesTheResonance) {

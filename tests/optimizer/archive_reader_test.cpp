@@ -5,8 +5,13 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <sqlite3.h>
+
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include "abuopt/common/config_error.hpp"
 
@@ -39,6 +44,87 @@ void store(const std::string& path, const std::string& id, const std::vector<std
   a.record_metadata("optimize", "cfg.yaml", "fnv1a64:0");
   ArchivedProblem ap(p, a);
   for (const auto& x : xs) (void)ap.evaluate(x);
+}
+
+std::string bytes_of(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::vector<std::string> listing(const fs::path& dir) {
+  std::vector<std::string> v;
+  for (const auto& e : fs::directory_iterator(dir)) v.push_back(e.path().filename().string());
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+TEST(ArchiveReader, ReadsWithoutWriting) {
+  // A reader opens the file read-only: an archive in a read-only file and directory (0444 in 0555)
+  // is read and left byte-identical, no file added beside it. Both journal modes: WAL (as written;
+  // read as immutable when no -shm can be made) and rollback, where a reader setting
+  // journal_mode=WAL (as the writer does) changes the header, caught even as root (whom the
+  // permissions do not bind).
+  for (const char* journal : {"DELETE", "WAL"}) {
+    SCOPED_TRACE(journal);
+    const std::string path = fresh_archive();
+    const fs::path dir = fs::path(path).parent_path();
+    store(path, "linear-aaaa", {{1, 3}, {2, 1.5}});
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db, (std::string("PRAGMA journal_mode=") + journal).c_str(), nullptr, nullptr, nullptr),
+              SQLITE_OK);
+    sqlite3_close(db);
+    const std::string before = bytes_of(path);
+    const std::vector<std::string> files = listing(dir);
+    fs::permissions(path, fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
+    fs::permissions(dir, fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
+                             fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec);
+    std::size_t problems = 0, evaluations = 0, runs = 0;
+    std::string error;
+    try {
+      const ArchiveReader r(path);
+      problems = r.problems().size();
+      evaluations = r.problem("linear").evaluations.size();
+      runs = r.problem("linear").runs.size();
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    const std::vector<std::string> files_after = listing(dir);
+    fs::permissions(dir, fs::perms::owner_all);
+    fs::permissions(path, fs::perms::owner_read | fs::perms::owner_write);
+    EXPECT_EQ(error, "");
+    EXPECT_EQ(problems, 1u);
+    EXPECT_EQ(evaluations, 2u);
+    EXPECT_EQ(runs, 1u);
+    EXPECT_TRUE(bytes_of(path) == before) << "the reader changed the archive";
+    // Root may write the directory anyway: SQLite then makes the WAL's -wal and -shm files, which a
+    // read-only connection cannot remove (empty; the next writer takes them). Nothing else is added.
+    std::vector<std::string> added;
+    for (const auto& f : files_after)
+      if (std::find(files.begin(), files.end(), f) == files.end()) added.push_back(f);
+    if (std::string(journal) == "WAL" && ::geteuid() == 0)
+      std::erase_if(added, [](const std::string& f) { return f == "a.sqlite-wal" || f == "a.sqlite-shm"; });
+    EXPECT_EQ(added, std::vector<std::string>{});
+  }
+}
+
+TEST(ArchiveReader, MissingOrEmptyFileIsAnErrorAndNotCreated) {
+  const std::string path = fresh_archive();
+  try {
+    ArchiveReader r(path);
+    ADD_FAILURE() << "a missing file was read";
+  } catch (const abuopt::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("no such file"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(path));
+  { std::ofstream(path, std::ios::binary); }  // an empty file: not an archive, and left empty
+  try {
+    ArchiveReader r(path);
+    ADD_FAILURE() << "an empty file was read as an archive";
+  } catch (const abuopt::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("not an evaluation archive"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(fs::file_size(path), 0u);
 }
 
 TEST(ArchiveReader, BestFeasibleHistoryAndFilters) {

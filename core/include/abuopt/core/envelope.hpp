@@ -15,8 +15,9 @@
 // the parameter's bit of run i's cell; sobol: coordinate p of the joint point
 // (joint_sobol_coordinate). Either way: replayable from (S, i) alone, independent of the thread
 // count, of the ranks and of which other parameters are uncertain. Friction and imbalance mass use
-// the streams of montecarlo.friction.range / montecarlo.imbalance.mass_relative_range, so an
-// envelope uniform equals the old key's range draw for draw.
+// the streams of montecarlo.friction.range / montecarlo.imbalance.mass_relative_range, so with
+// sampling: random an envelope uniform equals the old key's range draw for draw; the default,
+// stratified, moves each draw into its run's cell and so gives other draws (same distribution).
 #include <cstdint>
 #include <string>
 

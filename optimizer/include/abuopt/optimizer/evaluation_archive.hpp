@@ -83,9 +83,15 @@ class EvaluationArchive {
     std::string created;
   };
 
-  // Opens or creates the archive file; throws abuopt::ConfigError naming the file if it cannot, if
-  // SQLite finds it damaged, or if it has another schema version.
-  EvaluationArchive(const std::string& path, std::string problem_id);
+  // ReadOnly (the archive readers: list, show, best, history, Python abuopt.Archive): the file must
+  // exist and be an archive; nothing is written (no schema, no journal mode, damaged rows are left
+  // out but not deleted), so a read-only file or directory can be read and is left byte-identical.
+  enum class OpenMode { ReadWrite, ReadOnly };
+
+  // Opens or creates (ReadWrite) the archive file; throws abuopt::ConfigError naming the file if it
+  // cannot, if SQLite finds it damaged, if it has another schema version, or (ReadOnly) if it is
+  // missing or not an archive.
+  EvaluationArchive(const std::string& path, std::string problem_id, OpenMode mode = OpenMode::ReadWrite);
   ~EvaluationArchive();
   EvaluationArchive(const EvaluationArchive&) = delete;
   EvaluationArchive& operator=(const EvaluationArchive&) = delete;
@@ -131,6 +137,7 @@ class EvaluationArchive {
   void discard_damaged(long id, const std::string& what) const;
   std::string path_;
   std::string problem_id_;
+  bool read_only_ = false;
   sqlite3* db_ = nullptr;
   mutable std::mutex mutex_;
   std::function<void(const std::string&)> warn_;
