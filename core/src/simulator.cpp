@@ -87,6 +87,11 @@ Simulator::Simulator(SimulationSetup setup) : setup_(std::move(setup)) {
   // are C1, but dropping them as stops made a mismatch run fail: FeedForward.TheDriveFollowsTheProfile.)
   const StartupProfile& ref = reference_ ? *reference_ : setup_.profile;
   stop_times_s_ = ref.breakpoints_s();
+  if (reference_ && setup_.motor.quantize_setpoint_1hz) {
+    // whole-Hz feed-forward: the held reference changes only at its steps, not at the joins
+    stop_times_s_ = setup_.profile.breakpoints_s();
+    stop_times_s_.push_back(reference_->duration_s());
+  }
   if (setup_.motor.kind == MotorKind::PI && setup_.motor.quantize_setpoint_1hz) {
     const std::vector<double> steps = setup_.motor.reference_step_times_s(ref);
     stop_times_s_.insert(stop_times_s_.end(), steps.begin(), steps.end());
