@@ -83,8 +83,9 @@ Simulator::Simulator(SimulationSetup setup) : setup_(std::move(setup)) {
   if (setup_.motor.kind == MotorKind::PI && setup_.motor.feedforward.enabled)
     reference_ = std::make_shared<const StartupProfile>(feedforward_setpoint(setup_.profile, setup_.motor, end_time_s()));
   // The integrator's stop times, once for every run (not per run: the feed-forward setpoint has ~100
-  // segments a second): the reference's breakpoints and the quantised reference's steps. (Its joins
-  // are C1, but dropping them as stops made a mismatch run fail: FeedForward.TheDriveFollowsTheProfile.)
+  // segments a second): the reference's breakpoints and the quantised reference's steps. The exact
+  // setpoint keeps its joins as stops (C1 there, but without them a mismatch run failed with a too
+  // small step: FeedForward.TheDriveFollowsTheProfile).
   const StartupProfile& ref = reference_ ? *reference_ : setup_.profile;
   stop_times_s_ = ref.breakpoints_s();
   if (reference_ && setup_.motor.quantize_setpoint_1hz) {
