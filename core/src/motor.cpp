@@ -35,7 +35,7 @@ std::vector<double> MotorModel::reference_step_times_s(const StartupProfile& pro
 
 std::string to_string(MotorKind k) { return k == MotorKind::Ideal ? "ideal" : "pi"; }
 
-StartupProfile feedforward_setpoint(const StartupProfile& wanted, const MotorModel& m) {
+StartupProfile feedforward_setpoint(const StartupProfile& wanted, const MotorModel& m, double end_time_s) {
   constexpr double kTwoPi = 2.0 * 3.14159265358979323846;
   const FeedForward& ff = m.feedforward;
   if (m.kind != MotorKind::PI || !ff.enabled)
@@ -51,6 +51,7 @@ StartupProfile feedforward_setpoint(const StartupProfile& wanted, const MotorMod
   const long n = std::max(1L, std::lround(total / ff.interval_s));
   const double h = total / static_cast<double>(n);
   constexpr int kSubsteps = 100;
+  constexpr double kTailToleranceHz = 1e-4;
   const double dt = h / kSubsteps;
   const double w = m.omega_m_rad_s, load = m.bearing_torque_Nm / m.inertia_kgm2;
   // delta' of the inversion at (t, delta)
@@ -61,9 +62,25 @@ StartupProfile feedforward_setpoint(const StartupProfile& wanted, const MotorMod
   };
   std::vector<InclinedSineSegment> out;
   out.reserve(static_cast<std::size_t>(n));
-  double delta = 0.0, err = 0.0;
-  for (long k = 0; k < n; ++k) {
-    const double t0 = h * static_cast<double>(k);
+  // the value the drive is given for the realised reference f (inverse of eq 2.1, whole Hz)
+  double err = 0.0;
+  auto given = [&](double f, bool feedback) {
+    if (m.setpoint_mismatch) f = (64.0 * f + 1.0) / 63.0;  // inverse of eq 2.1
+    if (m.quantize_setpoint_1hz) {
+      const double q = std::round(f + (feedback ? err : 0.0));
+      if (feedback) err += f - q;
+      f = q;
+    }
+    return f;
+  };
+  const double f_end = wanted.final_frequency_hz();
+  double delta = 0.0;
+  // the profile's intervals, then (up to end_time_s) the settling tail with the wanted speed held at
+  // f_end, until the exact setpoint is within kTailToleranceHz of f_end
+  for (long k = 0;; ++k) {
+    const double t0 = h * static_cast<double>(k), t1 = h * static_cast<double>(k + 1);
+    const bool tail = k >= n;
+    if (tail && t1 > end_time_s * (1 + 1e-12)) break;
     for (int j = 0; j < kSubsteps; ++j) {
       const double t = t0 + dt * j;
       const double k1 = ddelta(t, delta);
@@ -72,19 +89,17 @@ StartupProfile feedforward_setpoint(const StartupProfile& wanted, const MotorMod
       const double k4 = ddelta(t + dt, delta + dt * k3);
       delta += dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
     }
-    const double t1 = h * static_cast<double>(k + 1);
     double f = wanted.frequency_hz(t1) + ddelta(t1, delta) / kTwoPi;  // the realised reference wanted
     if (!(f >= 0 && f <= kMaxFrequencyHz))
       throw ConfigError("motor.feedforward", "setpoint " + format_shortest(f) + " Hz at t = " + format_shortest(t1) + " s",
                         "must be in [0, " + format_shortest(kMaxFrequencyHz) +
                             "] Hz: the profile asks the drive for more than its loop can be steered to (make it slower)");
-    if (m.setpoint_mismatch) f = (64.0 * f + 1.0) / 63.0;  // inverse of eq 2.1
-    if (m.quantize_setpoint_1hz) {
-      const double q = std::round(f + err);
-      err += f - q;
-      f = q;
+    if (tail && std::abs(f - f_end) <= kTailToleranceHz) {
+      out.push_back({given(f_end, false), h});  // settled: from here the drive holds f_end itself
+      break;
     }
-    out.push_back({f, h});
+    out.push_back({given(f, true), h});
+    if (k + 1 == n && !(end_time_s > total)) break;  // no tail asked for
   }
   return StartupProfile(std::move(out), 0.0);
 }

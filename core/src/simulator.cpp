@@ -81,7 +81,24 @@ Simulator::Simulator(SimulationSetup setup) : setup_(std::move(setup)) {
     }
   }
   if (setup_.motor.kind == MotorKind::PI && setup_.motor.feedforward.enabled)
-    reference_ = std::make_shared<const StartupProfile>(feedforward_setpoint(setup_.profile, setup_.motor));
+    reference_ = std::make_shared<const StartupProfile>(feedforward_setpoint(setup_.profile, setup_.motor, end_time_s()));
+  // The integrator's stop times, once for every run (not per run: the feed-forward setpoint has ~100
+  // segments a second): the reference's breakpoints and the quantised reference's steps. The exact
+  // setpoint keeps its joins as stops (C1 there, but without them a mismatch run failed with a too
+  // small step: FeedForward.TheDriveFollowsTheProfile).
+  const StartupProfile& ref = reference_ ? *reference_ : setup_.profile;
+  stop_times_s_ = ref.breakpoints_s();
+  if (reference_ && setup_.motor.quantize_setpoint_1hz) {
+    // whole-Hz feed-forward: the held reference changes only at its steps, not at the joins
+    stop_times_s_ = setup_.profile.breakpoints_s();
+    stop_times_s_.push_back(reference_->duration_s());
+  }
+  if (setup_.motor.kind == MotorKind::PI && setup_.motor.quantize_setpoint_1hz) {
+    const std::vector<double> steps = setup_.motor.reference_step_times_s(ref);
+    stop_times_s_.insert(stop_times_s_.end(), steps.begin(), steps.end());
+  }
+  std::sort(stop_times_s_.begin(), stop_times_s_.end());
+  stop_times_s_.erase(std::unique(stop_times_s_.begin(), stop_times_s_.end()), stop_times_s_.end());
 }
 
 Simulator::~Simulator() = default;
@@ -98,7 +115,8 @@ namespace {
 class Run {
  public:
   Run(const SimulationSetup& setup, double end_time_s, const std::vector<double>& beta0, const RunOverrides& ov,
-      std::vector<TrajectoryPoint>* trajectory, const StuckForcingTable* stuck_table, const StartupProfile& reference)
+      std::vector<TrajectoryPoint>* trajectory, const StuckForcingTable* stuck_table, const StartupProfile& reference,
+      const std::vector<double>& stop_times_s)
       : setup_(setup), ref_(reference), p_(with_overrides(setup.abu, ov)), rs_(p_), lay_(rs_.lay()), trajectory_(trajectory) {
     rs_.profile = &ref_;  // the ideal motor's speed, or the PI drive's setpoint
     rs_.motor = setup_.motor;
@@ -117,13 +135,14 @@ class Run {
     t_end_ = end_time_s * w_;
     t_profile_ = ref_.duration_s() * w_;
     out_.end_time_s = end_time_s;
+    stops_.reserve(stop_times_s.size());
+    for (double s : stop_times_s) stops_.push_back(s * w_);
     L_mm_ = p_.ball_track_radius_m * 1e3;
     traj_dt_ = rs_.opt.trajectory_interval_s * w_;
     if (rs_.pi_motor && rs_.motor.quantize_setpoint_1hz) {
-      // The quantised reference is piecewise constant: its step times join the profile's
-      // breakpoints as stop times, and it is held per interval (docs/model.md).
+      // The quantised reference is piecewise constant: its step times are among the stop times,
+      // and it is held per interval (docs/model.md).
       rs_.ref_held = true;
-      for (double s : rs_.motor.reference_step_times_s(ref_)) ref_steps_.push_back(s * w_);
       hold_reference_after(0.0);
     }
 
@@ -199,7 +218,7 @@ class Run {
   std::vector<int> rinfo_;
   std::vector<char> fixed_;
   std::deque<double> recent_events_;
-  std::vector<double> ref_steps_;  // step times of the quantised reference (tbar), sorted
+  std::vector<double> stops_;  // the Simulator's stop times (tbar), sorted, distinct
   std::optional<StuckPropagator> stuck_;
   std::optional<RunForcingTable> run_table_;
   std::optional<RunStuckPropagator> stuck_run_;
@@ -212,10 +231,8 @@ class Run {
 void Run::hold_reference_after(double tbar) {
   // next stop after tbar: a reference step or a profile breakpoint (or the profile's end)
   double next = std::max(t_end_, t_profile_) + 1.0;
-  for (double b : ref_.breakpoints_s())
-    if (b * w_ > tbar) next = std::min(next, b * w_);
-  const auto it = std::upper_bound(ref_steps_.begin(), ref_steps_.end(), tbar);
-  if (it != ref_steps_.end()) next = std::min(next, *it);
+  const auto it = std::upper_bound(stops_.begin(), stops_.end(), tbar);
+  if (it != stops_.end()) next = std::min(next, *it);
   const double mid = 0.5 * (tbar + next) / w_;
   rs_.ref_hold_hz = rs_.motor.realised_reference_hz(ref_.frequency_hz(mid));
 }
@@ -357,14 +374,8 @@ RunOutcome Run::execute() {
   if (event_driven_) set_root_offsets(rs_, t, y.data());
 
   std::vector<double> breaks;
-  for (double b : ref_.breakpoints_s())
-    if (b * w_ > 0 && b * w_ < t_end_) breaks.push_back(b * w_);
-  if (!ref_steps_.empty()) {
-    for (double b : ref_steps_)
-      if (b > 0 && b < t_end_) breaks.push_back(b);
-    std::sort(breaks.begin(), breaks.end());
-    breaks.erase(std::unique(breaks.begin(), breaks.end()), breaks.end());
-  }
+  for (double b : stops_)
+    if (b > 0 && b < t_end_) breaks.push_back(b);
   breaks.push_back(t_end_);
   std::size_t next_break = 0;
   integ.set_stop(breaks[0]);
@@ -494,7 +505,8 @@ RunOutcome Simulator::run(const std::vector<double>& beta0, const RunOverrides& 
     // the abu section's rules: stiffness > 0, imbalance mass >= 0 (a balanced rotor is a valid ABU)
     throw std::invalid_argument("Simulator::run: an override is out of range (stiffness > 0, imbalance mass >= 0, "
                                 "restitution in [0, 1])");
-  Run run(setup_, end_time_s(), beta0, ov, trajectory, stuck_table_.get(), reference_ ? *reference_ : setup_.profile);
+  Run run(setup_, end_time_s(), beta0, ov, trajectory, stuck_table_.get(), reference_ ? *reference_ : setup_.profile,
+          stop_times_s_);
   RunOutcome out = run.execute();
   out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return out;

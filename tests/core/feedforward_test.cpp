@@ -196,3 +196,44 @@ TEST(FeedForward, ConfigKeysAndErrors) {
             std::string::npos);
   EXPECT_EQ(error_of(head + "motor: {kind: pi, feedforward: {enabled: false, interval_s: 0.02}}\n"), "<no error>");
 }
+
+// The settling tail (review finding 3): at the end of a ramp the exact setpoint is still away from
+// the end speed (the error decays as e^(-2.2 t)); holding the profile's last sample set the final
+// speed wrong for the whole tail, where the residual imbalance is measured. With the end time the
+// setpoint goes on to f_end itself, and the drive ends at f_end.
+TEST(FeedForward, TheSettlingTailEndsAtTheProfilesEndSpeed) {
+  const StartupProfile ramp({{25, 2.0}}, 0.0);  // ends on a ramp
+  for (bool whole_hz : {false, true}) {
+    SCOPED_TRACE(whole_hz ? "1 Hz setpoints" : "exact setpoints");
+    const MotorModel m = ff_pi(whole_hz);
+    const StartupProfile cut = feedforward_setpoint(ramp, m);  // no end time: the profile's samples only
+    const StartupProfile tail = feedforward_setpoint(ramp, m, 12.0);
+    ASSERT_EQ(cut.segments().size(), 200u);
+    // the old hold: off by more than 3 Hz (the exact setpoint is 21.25 Hz at 2 s)
+    if (!whole_hz) {
+      EXPECT_GT(std::fabs(cut.final_frequency_hz() - 25.0), 3.0);
+    }
+    // the profile's samples unchanged, then a tail (4.8 s) that ends at 25 Hz exactly
+    for (std::size_t k = 0; k < 200; ++k)
+      ASSERT_EQ(tail.segments()[k].end_frequency_hz, cut.segments()[k].end_frequency_hz) << k;
+    EXPECT_GT(tail.duration_s(), 3.0);
+    EXPECT_LT(tail.duration_s(), 12.0 - 1e-9);
+    EXPECT_EQ(tail.final_frequency_hz(), 25.0);
+    // an end time before the tail has settled: the tail stops there
+    EXPECT_NEAR(feedforward_setpoint(ramp, m, 2.5).duration_s(), 2.5, 1e-9);
+
+    // the drive's real speed at the end of a run: within 0.01 Hz of 25 Hz (the held last sample: 3.75 Hz off)
+    SimulationSetup s;
+    s.profile = ramp;
+    s.motor = m;
+    s.abu.friction_mu = 0.02;
+    s.options.trajectory_interval_s = 0.01;
+    s.options.end_time_s = 12.0;
+    std::vector<TrajectoryPoint> traj;
+    const RunOutcome out = Simulator(s).run({0.5, 2.0}, {}, &traj);
+    ASSERT_EQ(out.status, RunStatus::Ok) << out.message;
+    ASSERT_FALSE(traj.empty());
+    EXPECT_NEAR(traj.back().t_s, 12.0, 0.011);
+    EXPECT_NEAR(traj.back().frequency_hz, 25.0, 0.01);
+  }
+}

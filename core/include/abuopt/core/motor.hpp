@@ -62,10 +62,15 @@ std::string to_string(MotorKind k);
 //   running sum follows the exact setpoint's; the loop, 0.35 Hz, averages the +-1 Hz dither);
 // - with setpoint_mismatch the samples are pre-distorted by the inverse of eq 2.1,
 //   f_target = (64 f + 1)/63, so that the drive's realised reference is the setpoint.
-// After the profile the drive holds the last sample. Throws ConfigError ("motor.feedforward")
+// At the end of a ramp the exact setpoint is still away from the profile's end speed f_end (its
+// error decays with the pole above), so with end_time_s > the profile's duration the inversion goes
+// on past the profile with the wanted speed held at f_end (the settling tail, up to end_time_s) until
+// the setpoint is within 1e-4 Hz of f_end; its last sample is f_end itself (pre-distorted, whole Hz),
+// which the drive then holds. With end_time_s <= the duration: the profile's samples only, the drive
+// holding the last one. Throws ConfigError ("motor.feedforward")
 // when the profile does not start from rest, the motor is not PI or feed-forward is off, the
 // interval is not in (0, duration], or a sample falls outside [0, kMaxFrequencyHz] (a design too
 // fast for the loop).
-StartupProfile feedforward_setpoint(const StartupProfile& wanted, const MotorModel& motor);
+StartupProfile feedforward_setpoint(const StartupProfile& wanted, const MotorModel& motor, double end_time_s = 0);
 
 }  // namespace abuopt

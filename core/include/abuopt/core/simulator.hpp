@@ -105,6 +105,9 @@ class Simulator {
   // What the PI drive is steered with: the profile, or its feed-forward setpoint
   // (motor.feedforward, computed once here).
   std::shared_ptr<const StartupProfile> reference_;
+  // The runs' stop times (s, sorted, distinct): the reference's breakpoints and the quantised
+  // reference's steps (computed once here, scaled per run).
+  std::vector<double> stop_times_s_;
 };
 
 }  // namespace abuopt
