@@ -19,6 +19,14 @@
 //     best of three in thread CPU time. Counters: ratio = sum of the study's run times / sum of the nominal runs'
 //     (1.0: an uncertain parameter costs nothing), ms_per_run of both, and differ = runs whose
 //     |I_r| differs by more than 1e-9 relative (expected 0: the same physics).
+// BM_InterleavedDesigns  6 designs (the 2003 profile, its last segment 0, 1, ..., 5 % longer) with
+//     the report's stiffness envelope (2-3 forcing-sample rungs each), ABUOPT_BENCH_RUNS (default
+//     24) runs per design evaluated interleaved (design 0 run 0, design 1 run 0, ...), one thread,
+//     thread CPU time, in one program run: before = the replaced process-wide LRU cache of 8
+//     (profile, rung) entries replayed (a miss builds the rung: the run on a fresh Simulator; a hit:
+//     on the design's Simulator), after = each design's Simulator keeping its rungs. Counters:
+//     misses_before (of 6 x runs), ratio = before / after, ms_per_run of both, differ = runs whose
+//     outcome differs (expected 0).
 // BM_ParallelEfficiency  the study without reuse on 1 and then 2 threads; counters t1_s, t2_s,
 //     speedup = t1/t2 and efficiency = speedup / 2 (1.0 = perfect scaling). On a machine shared
 //     with other jobs the figures are lower bounds.
@@ -29,12 +37,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <deque>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "abuopt/core/monte_carlo.hpp"
 #include "abuopt/core/monte_carlo_stats.hpp"
 #include "abuopt/core/simulator.hpp"
+#include "run_forcing_table.hpp"
 
 namespace {
 
@@ -188,6 +200,84 @@ void BM_UncertainParameterCost(benchmark::State& state) {
   state.counters["nominal_ms_per_run"] = 1e3 * t_nominal / static_cast<double>(s.runs);
   state.counters["differ"] = static_cast<double>(differ);
 }
+void BM_InterleavedDesigns(benchmark::State& state) {
+  constexpr std::size_t kDesigns = 6, kOldCache = 8;
+  const char* e = std::getenv("ABUOPT_BENCH_RUNS");
+  const std::size_t runs =
+      e && std::strtol(e, nullptr, 10) > 0 ? static_cast<std::size_t>(std::strtol(e, nullptr, 10)) : 24;
+  std::vector<MonteCarloStudy> studies;
+  std::vector<PreparedStudy> prepared;
+  for (std::size_t d = 0; d < kDesigns; ++d) {
+    MonteCarloStudy s;
+    s.reuse_exchangeable = false;
+    std::vector<InclinedSineSegment> seg = StartupProfile::report_final().segments();
+    seg.back().duration_s *= 1.0 + 0.01 * static_cast<double>(d);
+    s.setup.profile = StartupProfile(seg);
+    s.design.kind = InitialConditionKind::Random;
+    s.design.seed = 40 + d;
+    s.seed = 40 + d;
+    s.runs = runs;
+    s.uncertain.envelope.stiffness_factor = Envelope::report().stiffness_factor;
+    studies.push_back(s);
+    prepared.push_back(prepare_study(s));
+  }
+  // the old cache's key of a run: (design, ladder step of the run's damped frequency)
+  auto rung = [&](std::size_t d, const MonteCarloSample& smp) {
+    AbuParameters p = studies[d].setup.abu;
+    p.stiffness_N_per_m = smp.stiffness_N_per_m;
+    return detail::ForcingSamples::ladder(detail::RunForcingTable::damped_frequency(NondimParameters::from(p)));
+  };
+  double t_before = 0, t_after = 0;
+  std::size_t misses = 0, differ = 0;
+  for (auto _ : state) {
+    t_before = t_after = 0;
+    misses = differ = 0;
+    std::vector<RunOutcome> before(kDesigns * runs);
+    {
+      std::vector<std::unique_ptr<Simulator>> sims;
+      for (const auto& s : studies) sims.push_back(std::make_unique<Simulator>(s.setup));
+      std::deque<std::pair<std::size_t, double>> lru;  // most recently used first
+      for (std::size_t i = 0; i < runs; ++i)
+        for (std::size_t d = 0; d < kDesigns; ++d) {
+          const MonteCarloSample& smp = prepared[d].samples[i];
+          const std::pair<std::size_t, double> key{d, rung(d, smp)};
+          const auto it = std::find(lru.begin(), lru.end(), key);
+          const bool hit = it != lru.end();
+          if (hit) lru.erase(it);
+          lru.push_front(key);
+          if (lru.size() > kOldCache) lru.pop_back();
+          std::unique_ptr<Simulator> fresh = hit ? nullptr : std::make_unique<Simulator>(studies[d].setup);
+          misses += hit ? 0 : 1;
+          const double t0 = thread_cpu_s();
+          before[d * runs + i] = (hit ? *sims[d] : *fresh).run(smp.beta0, smp.overrides);
+          t_before += thread_cpu_s() - t0;
+        }
+    }
+    {
+      std::vector<std::unique_ptr<Simulator>> sims;
+      for (const auto& s : studies) sims.push_back(std::make_unique<Simulator>(s.setup));
+      for (std::size_t i = 0; i < runs; ++i)
+        for (std::size_t d = 0; d < kDesigns; ++d) {
+          const MonteCarloSample& smp = prepared[d].samples[i];
+          const double t0 = thread_cpu_s();
+          const RunOutcome o = sims[d]->run(smp.beta0, smp.overrides);
+          t_after += thread_cpu_s() - t0;
+          const RunOutcome& b = before[d * runs + i];
+          if (o.beta_final != b.beta_final || o.residual_imbalance_kgm != b.residual_imbalance_kgm) ++differ;
+        }
+    }
+    state.SetIterationTime(t_before + t_after);
+  }
+  const double n = static_cast<double>(kDesigns * runs);
+  state.counters["runs"] = n;
+  state.counters["misses_before"] = static_cast<double>(misses);
+  state.counters["ratio"] = t_before / t_after;
+  state.counters["before_ms_per_run"] = 1e3 * t_before / n;
+  state.counters["after_ms_per_run"] = 1e3 * t_after / n;
+  state.counters["differ"] = static_cast<double>(differ);
+}
+BENCHMARK(BM_InterleavedDesigns)->Iterations(1)->UseManualTime()->Unit(benchmark::kSecond);
+
 BENCHMARK(BM_UncertainParameterCost)
     ->ArgName("param")
     ->DenseRange(0, 5)

@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <deque>
 #include <mutex>
 #include <stdexcept>
 
@@ -107,44 +106,51 @@ std::size_t ForcingSamples::interval(double t_s) const {
   return std::min(j, intervals() - 1);
 }
 
-bool ForcingSamples::same(const StartupProfile& profile, double wd_ref, double t_end_s) const {
-  if (!(t_end_s == t_end_s_ && wd_ref == wd_ref_ && profile.start_frequency_hz() == profile_.start_frequency_hz() &&
-        profile.segments().size() == profile_.segments().size()))
-    return false;
-  for (std::size_t k = 0; k < profile.segments().size(); ++k)
-    if (profile.segments()[k].end_frequency_hz != profile_.segments()[k].end_frequency_hz ||
-        profile.segments()[k].duration_s != profile_.segments()[k].duration_s)
-      return false;
-  return true;
+SimulatorForcing::SimulatorForcing(const StartupProfile& profile, const NondimParameters& nominal, double t_end_s)
+    : profile_(profile), nominal_(nominal), t_end_s_(t_end_s) {}
+
+const StuckForcingTable* SimulatorForcing::nominal(const NondimParameters& nd) {
+  if (!(nd.omega_n == nominal_.omega_n && nd.bbar == nominal_.bbar) || !StuckForcingTable::supports(nominal_))
+    return nullptr;
+  std::call_once(nominal_once_, [this] {
+    try {
+      nominal_table_ = StuckForcingTable::shared(profile_, nominal_, t_end_s_ * nominal_.omega_n);
+    } catch (const std::invalid_argument&) {
+      // a profile too long for a stored table (kMaxStoredIntervals): the runs use the rungs
+    }
+  });
+  return nominal_table_.get();
 }
 
-std::shared_ptr<const ForcingSamples> ForcingSamples::shared(const StartupProfile& profile, double wd,
-                                                             double t_end_s) {
-  static std::mutex mutex;
-  static std::deque<std::shared_ptr<const ForcingSamples>> cache;  // most recently used first
-  const double ref = ladder(wd);
-  auto lookup = [&]() -> std::shared_ptr<const ForcingSamples> {
-    for (auto it = cache.begin(); it != cache.end(); ++it)
-      if ((*it)->same(profile, ref, t_end_s)) {
-        auto hit = *it;
-        if (it != cache.begin()) {
-          cache.erase(it);
-          cache.push_front(hit);
-        }
-        return hit;
-      }
-    return nullptr;
-  };
+std::shared_ptr<const ForcingSamples> SimulatorForcing::samples(double wd) {
+  const double ref = ForcingSamples::ladder(wd);
+  std::promise<std::shared_ptr<const ForcingSamples>> build;
+  std::shared_future<std::shared_ptr<const ForcingSamples>> rung;
+  bool builder = false;
   {
-    const std::lock_guard<std::mutex> lock(mutex);
-    if (auto hit = lookup()) return hit;
+    const std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = rungs_.find(ref);
+    if (it != rungs_.end()) {
+      rung = it->second;
+    } else {
+      rung = build.get_future().share();
+      rungs_.emplace(ref, rung);
+      builder = true;
+    }
   }
-  auto s = std::make_shared<const ForcingSamples>(profile, ref, t_end_s);
-  const std::lock_guard<std::mutex> lock(mutex);
-  if (auto hit = lookup()) return hit;  // another thread built it meanwhile
-  cache.push_front(s);
-  if (cache.size() > kShared) cache.pop_back();
-  return s;
+  if (builder) {  // outside the lock: other rungs stay available; this rung's users wait in get()
+    try {
+      build.set_value(std::make_shared<const ForcingSamples>(profile_, ref, t_end_s_));
+    } catch (...) {
+      build.set_exception(std::current_exception());
+    }
+  }
+  return rung.get();
+}
+
+std::size_t SimulatorForcing::rungs() const {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return rungs_.size();
 }
 
 double RunForcingTable::damped_frequency(const NondimParameters& nd) {

@@ -13,9 +13,16 @@
 // 14 complex multiply-adds, only for the intervals the run visits; closed form at constant speed).
 // The grid's spacing (half a period of Omega + omega_d) uses an omega_d from a ladder of 3 % steps
 // at or above the run's, so a handful of ForcingSamples serve a whole envelope.
+//
+// Who owns them: the Simulator (SimulatorForcing below): its rungs live as long as it does, so
+// several designs evaluated at once (batches, compare) no longer evict each other's rungs from a
+// small process-wide cache, and the first run to need a rung builds it while the others wait.
 #include <complex>
 #include <cstdint>
+#include <future>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "abuopt/core/abu_model.hpp"
@@ -30,12 +37,7 @@ class ForcingSamples {
   static constexpr int kNodes = 7;  // Gauss-Legendre nodes per interval (as StuckForcingTable)
   // The grid of a profile up to t_end_s with spacing kCheckFraction 2 pi / (Omega_max + wd_ref).
   ForcingSamples(const StartupProfile& profile, double wd_ref_rad_s, double t_end_s);
-  // The samples for a run with damped frequency wd [rad/s] (wd_ref = the ladder's step at or
-  // above wd) from a process-wide cache, or new (then cached). Thread-safe.
-  static std::shared_ptr<const ForcingSamples> shared(const StartupProfile& profile, double wd_rad_s,
-                                                      double t_end_s);
   static double ladder(double wd_rad_s);  // 1.03^ceil(log_1.03 wd)
-  static constexpr std::size_t kShared = 8;
 
   struct Piece {
     std::size_t j0 = 0, n = 0;  // first interval, intervals
@@ -61,9 +63,6 @@ class ForcingSamples {
     const Piece& p = pieces_[piece_of_[j]];
     return p.last_regular || j + 1 < p.j0 + p.n;
   }
-
- private:
-  bool same(const StartupProfile& profile, double wd_ref, double t_end_s) const;
 };
 
 // One run's view of ForcingSamples with the accessors of StuckForcingTable (non-dimensional time
@@ -112,6 +111,33 @@ class RunForcingTable {
   std::vector<PieceConstants> pc_;
   mutable std::size_t formed_ = static_cast<std::size_t>(-1);
   mutable cplx P_[2];
+};
+
+class StuckForcingTable;
+
+// A Simulator's stuck-phase forcing (thread-safe; one per Simulator, shared by its runs): the
+// nominal StuckForcingTable, built at the first run with the Simulator's own omega_n and bbar (a
+// study whose every run overrides stiffness or imbalance mass never builds it), and the
+// ForcingSamples rungs of the runs with their own, one per ladder step. Each is built once, by
+// the first run that needs it; runs needing it meanwhile wait for that build.
+class SimulatorForcing {
+ public:
+  SimulatorForcing(const StartupProfile& profile, const NondimParameters& nominal, double t_end_s);
+  // The nominal table when nd is the Simulator's (omega_n and bbar equal) and the table can be
+  // stored; else null.
+  const StuckForcingTable* nominal(const NondimParameters& nd);
+  // The samples for a run with damped frequency wd [rad/s] (the ladder's step at or above wd).
+  std::shared_ptr<const ForcingSamples> samples(double wd_rad_s);
+  std::size_t rungs() const;  // built or being built
+
+ private:
+  StartupProfile profile_;
+  NondimParameters nominal_;
+  double t_end_s_ = 0;
+  std::once_flag nominal_once_;
+  std::shared_ptr<const StuckForcingTable> nominal_table_;
+  mutable std::mutex mutex_;
+  std::map<double, std::shared_future<std::shared_ptr<const ForcingSamples>>> rungs_;  // by wd_ref
 };
 
 }  // namespace abuopt::detail

@@ -70,16 +70,10 @@ Simulator::Simulator(SimulationSetup setup) : setup_(std::move(setup)) {
     throw ConfigError("simulation.end_time_s", std::to_string(o.end_time_s),
                       "must be > 0 when the profile has no segments");
   // The exact stuck-phase propagator: its forcing integrals depend only on the profile and the
-  // table, so they are computed once here and shared by every run.
-  const NondimParameters nd = NondimParameters::from(setup_.abu);
+  // table, so they are computed once (by the first run that needs them) and shared by every run.
   if (o.stuck_integrator == StuckIntegrator::Exact && o.method == FrictionMethod::EventDriven &&
-      setup_.motor.kind == MotorKind::Ideal && StuckForcingTable::supports(nd)) {
-    try {
-      stuck_table_ = StuckForcingTable::shared(setup_.profile, nd, end_time_s() * nd.omega_n);
-    } catch (const std::invalid_argument&) {
-      // a profile too long for a stored table (kMaxStoredIntervals): the Runge-Kutta path, in bounded memory
-    }
-  }
+      setup_.motor.kind == MotorKind::Ideal)
+    forcing_ = std::make_shared<SimulatorForcing>(setup_.profile, NondimParameters::from(setup_.abu), end_time_s());
   if (setup_.motor.kind == MotorKind::PI && setup_.motor.feedforward.enabled)
     reference_ = std::make_shared<const StartupProfile>(feedforward_setpoint(setup_.profile, setup_.motor, end_time_s()));
   // The integrator's stop times, once for every run (not per run: the feed-forward setpoint has ~100
@@ -115,7 +109,7 @@ namespace {
 class Run {
  public:
   Run(const SimulationSetup& setup, double end_time_s, const std::vector<double>& beta0, const RunOverrides& ov,
-      std::vector<TrajectoryPoint>* trajectory, const StuckForcingTable* stuck_table, const StartupProfile& reference,
+      std::vector<TrajectoryPoint>* trajectory, SimulatorForcing* forcing, const StartupProfile& reference,
       const std::vector<double>& stop_times_s)
       : setup_(setup), ref_(reference), p_(with_overrides(setup.abu, ov)), rs_(p_), lay_(rs_.lay()), trajectory_(trajectory) {
     rs_.profile = &ref_;  // the ideal motor's speed, or the PI drive's setpoint
@@ -165,11 +159,11 @@ class Run {
     // mass) a view of the shared profile samples formed for this run (run_forcing_table.hpp).
     const bool exact = rs_.opt.stuck_integrator == StuckIntegrator::Exact && !rs_.pi_motor && event_driven_ &&
                        !(trajectory_ && traj_dt_ > 0);
-    if (exact && stuck_table && stuck_table->matches(rs_.nd)) {
+    const StuckForcingTable* stuck_table = exact && forcing ? forcing->nominal(rs_.nd) : nullptr;
+    if (stuck_table) {
       stuck_.emplace(*stuck_table, rs_, rs_.contact ? roots_contact : roots_plain);
-    } else if (exact && StuckForcingTable::supports(rs_.nd)) {
-      run_table_.emplace(
-          ForcingSamples::shared(setup_.profile, RunForcingTable::damped_frequency(rs_.nd), end_time_s), rs_.nd);
+    } else if (exact && forcing && StuckForcingTable::supports(rs_.nd)) {
+      run_table_.emplace(forcing->samples(RunForcingTable::damped_frequency(rs_.nd)), rs_.nd);
       stuck_run_.emplace(*run_table_, rs_, rs_.contact ? roots_contact : roots_plain);
     }
   }
@@ -505,7 +499,7 @@ RunOutcome Simulator::run(const std::vector<double>& beta0, const RunOverrides& 
     // the abu section's rules: stiffness > 0, imbalance mass >= 0 (a balanced rotor is a valid ABU)
     throw std::invalid_argument("Simulator::run: an override is out of range (stiffness > 0, imbalance mass >= 0, "
                                 "restitution in [0, 1])");
-  Run run(setup_, end_time_s(), beta0, ov, trajectory, stuck_table_.get(), reference_ ? *reference_ : setup_.profile,
+  Run run(setup_, end_time_s(), beta0, ov, trajectory, forcing_.get(), reference_ ? *reference_ : setup_.profile,
           stop_times_s_);
   RunOutcome out = run.execute();
   out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -2,6 +2,7 @@
 #include "abuopt/problems/startup_profile_problem.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -227,6 +228,7 @@ opt::Evaluation StartupProfileProblem::evaluate_with_threads(const StartupProfil
   BatchRunner& runner = runner_ ? *runner_ : own_runner;
   std::vector<MonteCarloSample> pooled;
   std::vector<double> objectives, pass_pct_mi;
+  std::vector<std::array<double, 2>> pass_hw;  // per pass: 95 % half-widths of mean |I_r|, I_r,x [kg m]
   double wall = 0;
   for (const auto& mu : passes) {
     if (mu) {
@@ -247,6 +249,8 @@ opt::Evaluation StartupProfileProblem::evaluate_with_threads(const StartupProfil
                                      (mu ? " at friction mu = " + format_number(*mu) : std::string()));
     objectives.push_back(objective_of(ps, r.samples));
     pass_pct_mi.push_back(ir(ps).pct_mi);
+    const IntervalLayout layout = interval_layout(st);
+    pass_hw.push_back({mean_half_width95(r.samples, layout, false), mean_half_width95(r.samples, layout, true)});
     for (auto& s : r.samples) pooled.push_back(std::move(s));
   }
   const MonteCarloStats all = compute_statistics(pooled);
@@ -261,19 +265,15 @@ opt::Evaluation StartupProfileProblem::evaluate_with_threads(const StartupProfil
   m["ir_x_mean"] = all.report_x.mean / kUnit;
   m["ir_x_median"] = all.report_x.median / kUnit;
   m["ir_x_max"] = all.report_x.max / kUnit;
-  // 95 % half-widths of the two means, 1.96 s / sqrt(n) over the ok runs (the sampling error of
-  // this design's figure; docs/sweep.md), and the Wilson interval of the %MI in use.
-  auto half_width_95 = [&pooled](bool x_definition) {
-    std::vector<double> v;
-    for (const auto& smp : pooled)
-      if (smp.outcome.ok())
-        v.push_back((x_definition ? smp.outcome.residual_imbalance_x_kgm : smp.outcome.residual_imbalance_kgm) / kUnit);
-    const double n = static_cast<double>(v.size());
-    if (v.size() < 2) return std::numeric_limits<double>::quiet_NaN();
-    double mean = 0, ss = 0;
-    for (double a : v) mean += a / n;
-    for (double a : v) ss += (a - mean) * (a - mean);
-    return 1.959963984540054 * std::sqrt(ss / (n - 1) / n);
+  // 95 % half-widths of the two means (the sampling error of this design's figure; docs/sweep.md):
+  // core's mean_half_width95 with each pass's sampling layout (independent runs, the envelope's
+  // strata or the Sobol' replicates: interval_layout), the passes combined as independent equal-
+  // weight means, sqrt(sum hw_p^2) / P; and the Wilson interval of the %MI in use.
+  auto half_width_95 = [&pass_hw](bool x_definition) {
+    double ss = 0;
+    for (const auto& hw : pass_hw) ss += hw[x_definition ? 1 : 0] * hw[x_definition ? 1 : 0];
+    return pass_hw.empty() ? std::numeric_limits<double>::quiet_NaN()
+                           : std::sqrt(ss) / static_cast<double>(pass_hw.size()) / kUnit;
   };
   m["ir_magnitude_mean_hw95"] = half_width_95(false);
   m["ir_x_mean_hw95"] = half_width_95(true);

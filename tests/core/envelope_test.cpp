@@ -456,6 +456,35 @@ TEST(EnvelopeConfig, FactorsMustKeepTheAbuRules) {
   EXPECT_NE(r.find("montecarlo.imbalance.mass_relative_range"), std::string::npos) << r;
   s.uncertain.imbalance_mass.relative_hi = 0.5;  // 7500 kg: inside the rule
   EXPECT_EQ(error(s), "no error");
+TEST(EnvelopeSimulator, RealRunsDoNotDependOnThreadsOrOrder) {
+  // The same check as RunOneReplaysAnyRunAndThreadsDoNotMatter with the real Simulator: a stiffness
+  // envelope (+-5 %, so the runs spread over about 3 rungs of the forcing samples' 3 % ladder, built
+  // by whichever run needs a rung first), a short profile, 24 runs on 1 and 3 threads and alone
+  // (run_one: a fresh Simulator per run): every outcome bit-identical.
+  MonteCarloStudy s = envelope_study(24);
+  s.setup.profile = StartupProfile({{25.0, 0.3}, {40.0, 0.3}});
+  s.uncertain.envelope = Envelope{};
+  s.uncertain.envelope.stiffness_factor = Envelope::report().stiffness_factor;
+  ASSERT_FALSE(s.uncertain.envelope.deterministic());
+  ThreadPoolRunner one(1), three(3);
+  const MonteCarloResult r1 = run_monte_carlo(s, one);
+  const MonteCarloResult r3 = run_monte_carlo(s, three);
+  ASSERT_EQ(r1.samples.size(), 24u);
+  ASSERT_EQ(r3.samples.size(), 24u);
+  double k_lo = 1e300, k_hi = 0;
+  auto same = [](const RunOutcome& a, const RunOutcome& b) {
+    return a.ok() && a.beta_final == b.beta_final && a.residual_imbalance_kgm == b.residual_imbalance_kgm &&
+           a.max_amplitude_mm == b.max_amplitude_mm && a.events == b.events && a.steps == b.steps;
+  };
+  for (std::size_t i = 0; i < 24; ++i) {
+    EXPECT_TRUE(same(r1.samples[i].outcome, r3.samples[i].outcome)) << "run " << i;
+    k_lo = std::min(k_lo, r1.samples[i].stiffness_N_per_m);
+    k_hi = std::max(k_hi, r1.samples[i].stiffness_N_per_m);
+  }
+  // the draws span more than one rung (omega_d ~ sqrt(k): a 3 % step is 6 % in k)
+  EXPECT_GT(k_hi / k_lo, 1.06);
+  for (std::size_t i : {0u, 11u, 23u})
+    EXPECT_TRUE(same(run_one(s, i).outcome, r1.samples[i].outcome)) << "run_one " << i;
 }
 
 TEST(EnvelopeSimulator, StiffnessMovesTheResonance) {

@@ -10,10 +10,12 @@
 #include <cmath>
 #include <complex>
 #include <random>
+#include <thread>
 #include <vector>
 
 #include "abuopt/core/simulator.hpp"
 #include "erk_stepper.hpp"
+#include "run_forcing_table.hpp"
 
 namespace {
 
@@ -26,6 +28,9 @@ using abuopt::detail::ErkStepper;
 using abuopt::detail::RunState;
 using abuopt::detail::StuckForcingTable;
 using abuopt::detail::StuckPropagator;
+using abuopt::NondimParameters;
+using abuopt::detail::ForcingSamples;
+using abuopt::detail::SimulatorForcing;
 
 // Every ball stuck at the given angles, ideal motor, event-driven (the frozen right-hand side).
 struct Stuck {
@@ -269,4 +274,33 @@ TEST(StuckForcingTable, TheConstantSpeedSpanAfterTheProfileIsComputedNotStored) 
     EXPECT_DOUBLE_EQ(tab.speed(j + 1), W);
     EXPECT_EQ(tab.speed_rate(j + 1), 0.0);
   }
+}
+
+// A Simulator's forcing (run_forcing_table.hpp, SimulatorForcing): each ladder rung is built once,
+// by the first thread that asks, and every thread gets that one; the nominal table only for the
+// Simulator's own omega_n and bbar.
+TEST(SimulatorForcing, OneBuildPerRungAndNominalOnlyWhenItMatches) {
+  const StartupProfile p({{25.0, 0.5}, {40.0, 0.5}});
+  const NondimParameters nd = NondimParameters::from(AbuParameters{});
+  SimulatorForcing f(p, nd, 2.0);
+  const double wd = 2 * M_PI * 28.0;
+  std::vector<std::shared_ptr<const ForcingSamples>> got(6);
+  {
+    std::vector<std::thread> threads;
+    for (std::size_t i = 0; i < got.size(); ++i) threads.emplace_back([&, i] { got[i] = f.samples(wd); });
+    for (auto& t : threads) t.join();
+  }
+  for (const auto& g : got) EXPECT_EQ(g, got[0]);
+  EXPECT_EQ(f.rungs(), 1u);
+  EXPECT_EQ(f.samples(wd * 1.001), got[0]);  // the same rung (ladder step at or above)
+  EXPECT_NE(f.samples(wd * 1.05), got[0]);   // the next one up
+  EXPECT_EQ(f.rungs(), 2u);
+  EXPECT_EQ(got[0]->wd_ref_, ForcingSamples::ladder(wd));
+  NondimParameters other = nd;
+  other.omega_n *= 1.01;
+  EXPECT_EQ(f.nominal(other), nullptr);
+  const StuckForcingTable* t = f.nominal(nd);
+  ASSERT_NE(t, nullptr);
+  EXPECT_TRUE(t->matches(nd));
+  EXPECT_EQ(f.nominal(nd), t);
 }

@@ -184,6 +184,38 @@ TEST(StartupProfileProblem, ObjectiveKindsMatchTheEngineStatistics) {
   EXPECT_DOUBLE_EQ(w.evaluate(x).objective, 2 * st.magnitude.mean / 1e-7 + 0.5 * st.magnitude.pct_mi);
 }
 
+TEST(StartupProfileProblem, HalfWidthsFollowTheEnvelopesStrata) {
+  // With an envelope (stratified by default: 2 cells per uncertain parameter, here 4 strata) the
+  // 95 % half-widths of the means are core's stratified ones (mean_half_width95 with the study's
+  // interval_layout), not 1.96 s / sqrt(n) over all runs.
+  StartupProfileProblem p(settings_from(
+      "montecarlo: {design: random, runs: 12, threads: 1}\n"
+      "envelope:\n"
+      "  friction_mu: {uniform: [0.05, 0.3]}\n"
+      "  stiffness_factor: {uniform: [0.95, 1.05]}\n"
+      "design:\n"
+      "  segments:\n"
+      "    - end_frequency_hz: {min: 20, max: 40, x0: 35}\n"
+      "      duration_s: {min: 0.2, max: 1.0, x0: 0.4}\n"
+      "objective: {kind: mean}\n"));
+  const std::vector<double> x = {35, 0.4};
+  const opt::Evaluation e = p.evaluate(x);
+  ASSERT_TRUE(e.ok) << e.message;
+  MonteCarloStudy study = p.settings().study;
+  study.setup.profile = p.profile_at(x);
+  const IntervalLayout layout = interval_layout(study);
+  ASSERT_EQ(layout.kind, IntervalKind::Strata);
+  ASSERT_EQ(layout.groups, 4u);
+  ThreadPoolRunner runner(1);
+  const MonteCarloResult r = run_monte_carlo(study, runner);
+  ASSERT_EQ(r.samples.size(), 12u);
+  for (const bool xdef : {false, true}) {
+    const double want = mean_half_width95(r.samples, layout, xdef) / 1e-7;
+    ASSERT_TRUE(std::isfinite(want));
+    EXPECT_NEAR(e.metrics.at(xdef ? "ir_x_mean_hw95" : "ir_magnitude_mean_hw95"), want, 1e-12 * want) << xdef;
+  }
+}
+
 // The smooth objectives are core's smooth statistics of the same runs; the pct_mi constraint can use
 // the smoothed exceedance; the identity changes with them and not for the older keys.
 TEST(StartupProfileProblem, SmoothObjectivesAndConstraintAreTheEngineSmoothStatistics) {

@@ -23,6 +23,7 @@ namespace abuopt {
 
 namespace detail {
 class StuckForcingTable;
+class SimulatorForcing;
 }
 
 enum class FrictionMethod { EventDriven, SwitchModel };
@@ -99,9 +100,9 @@ class Simulator {
 
  private:
   SimulationSetup setup_;
-  // The forcing integrals of the exact stuck-phase propagator, shared by all runs (null when the
-  // Runge-Kutta path is used).
-  std::shared_ptr<const detail::StuckForcingTable> stuck_table_;
+  // The forcing integrals of the exact stuck-phase propagator, built by the first run that needs
+  // them and shared by all runs (null when the Runge-Kutta path is used).
+  std::shared_ptr<detail::SimulatorForcing> forcing_;
   // What the PI drive is steered with: the profile, or its feed-forward setpoint
   // (motor.feedforward, computed once here).
   std::shared_ptr<const StartupProfile> reference_;
