@@ -3,6 +3,7 @@
 // anything it had stored, and damage: a flipped byte in a stored value is detected by the row's
 // checksum and recomputed, garbage in the file is an error naming it, a schema version is checked.
 #include "abuopt/optimizer/evaluation_archive.hpp"
+#include "abuopt/common/output_file.hpp"
 
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -136,8 +137,9 @@ TEST(EvaluationArchive, ProblemIdReusedForAnotherProblemIsAnError) {
   }
 }
 
-TEST(EvaluationArchive, UnopenableFileIsAConfigError) {
-  EXPECT_THROW(EvaluationArchive("/nonexistent-dir/x/archive.sqlite", "p"), abuopt::ConfigError);
+TEST(EvaluationArchive, UncreatableFileIsAnOutputError) {
+  // an archive that cannot be created is a failed write (exit 4, docs/security.md), like any output file
+  EXPECT_THROW(EvaluationArchive("/nonexistent-dir/x/archive.sqlite", "p"), abuopt::OutputError);
 }
 
 TEST(ArchivedProblem, ARepeatedStudyIsAnsweredEntirelyFromTheArchive) {
