@@ -294,44 +294,6 @@ TEST(EnvelopeDraws, RunOneReplaysAnyRunAndThreadsDoNotMatter) {
   EXPECT_EQ(prepare_sample(shorter, 42).overrides.stiffness_N_per_m, r1.samples[42].overrides.stiffness_N_per_m);
 }
 
-TEST(EnvelopeSimulator, ThreadsAndReplayGiveTheSameRunsWithTheRealSimulator) {
-  // The same check as above with the real Simulator: a stiffness envelope (x U[0.95, 1.05]) makes
-  // the runs take the per-run views of the process-wide forcing-sample cache (run_forcing_table.hpp),
-  // built on first use by whichever worker needs a frequency rung first. A profile no other test
-  // uses, so its rungs are built here, under 3 threads, then reused: every run's final angles,
-  // residual and peak amplitude bitwise equal to 1 thread's, and to run_one's replay of it.
-  MonteCarloStudy s = envelope_study(24);
-  s.setup.profile = StartupProfile({{25.0, 1.0}, {29.5, 2.5}, {47.0, 1.5}});
-  ThreadPoolRunner one(1), three(3);
-  const MonteCarloResult r3 = run_monte_carlo(s, three);
-  const MonteCarloResult r1 = run_monte_carlo(s, one);
-  ASSERT_EQ(r3.samples.size(), 24u);
-  ASSERT_EQ(r1.samples.size(), 24u);
-  std::size_t stiffness_overridden = 0;
-  for (std::size_t i = 0; i < 24; ++i) {
-    const RunOutcome& a = r1.samples[i].outcome;
-    const RunOutcome& b = r3.samples[i].outcome;
-    ASSERT_TRUE(a.ok() && b.ok()) << a.message << b.message;
-    EXPECT_EQ(a.beta_final, b.beta_final) << "run " << i;
-    EXPECT_EQ(a.residual_imbalance_kgm, b.residual_imbalance_kgm) << "run " << i;
-    EXPECT_EQ(a.max_amplitude_mm, b.max_amplitude_mm) << "run " << i;
-    if (r1.samples[i].overrides.stiffness_N_per_m &&
-        *r1.samples[i].overrides.stiffness_N_per_m != s.setup.abu.stiffness_N_per_m)
-      ++stiffness_overridden;
-  }
-  EXPECT_EQ(stiffness_overridden, 24u);
-  // the runs differ from each other (the comparison is not of 24 copies of one number)
-  std::vector<double> residuals;
-  for (const auto& smp : r1.samples) residuals.push_back(smp.outcome.residual_imbalance_kgm);
-  std::sort(residuals.begin(), residuals.end());
-  EXPECT_GT(std::unique(residuals.begin(), residuals.end()) - residuals.begin(), 12);
-  for (std::size_t i : {0u, 11u, 23u}) {
-    const MonteCarloSample replay = run_one(s, i);
-    EXPECT_EQ(replay.outcome.beta_final, r1.samples[i].outcome.beta_final) << "run " << i;
-    EXPECT_EQ(replay.outcome.residual_imbalance_kgm, r1.samples[i].outcome.residual_imbalance_kgm) << "run " << i;
-  }
-}
-
 TEST(EnvelopeSimulator, AnOverrideEqualsTheNominalRunWithThatValue) {
   // Each drawn parameter reaches the simulator: run i with its overrides gives what a setup with
   // those values as nominal gives (same path: the Runge-Kutta stuck phases for both).
@@ -456,6 +418,8 @@ TEST(EnvelopeConfig, FactorsMustKeepTheAbuRules) {
   EXPECT_NE(r.find("montecarlo.imbalance.mass_relative_range"), std::string::npos) << r;
   s.uncertain.imbalance_mass.relative_hi = 0.5;  // 7500 kg: inside the rule
   EXPECT_EQ(error(s), "no error");
+}
+
 TEST(EnvelopeSimulator, RealRunsDoNotDependOnThreadsOrOrder) {
   // The same check as RunOneReplaysAnyRunAndThreadsDoNotMatter with the real Simulator: a stiffness
   // envelope (+-5 %, so the runs spread over about 3 rungs of the forcing samples' 3 % ladder, built
