@@ -386,12 +386,14 @@ TEST(Hardening3Cli, CompareStopsOnSigintKeepsTheArchiveWritesNoHalfTableAndResum
       if (line.rfind("optimizer:", 0) == 0) break;
       else sp += "      " + line + "\n";
   }
-  const std::string cfg = write_file("compare.yaml", "tau: 0.01\nproblems:\n  - label: sp\n    max_evaluations: 4\n"
-                                                     "    starts: 2\n    seed: 1\n    startup_profile:\n" + sp +
+  const std::string cfg = write_file("compare.yaml", "tau: 0.01\nproblems:\n  - label: sp\n    max_evaluations: 12\n"
+                                                     "    starts: 3\n    seed: 1\n    startup_profile:\n" + sp +
                                                      "solvers:\n  - label: COBYLA\n    algorithm: cobyla\n"
                                                      "  - label: SBPLX\n    algorithm: sbplx\n");
   const fs::path out = fresh_dir("compare_int");
-  const auto r = run_child({"compare", cfg, "--out", out.string(), "--progress"}, SignalPlan{SIGINT, 2.0, "", 0});
+  const auto r = run_child({"compare", cfg, "--out", out.string(), "--progress"}, SignalPlan{SIGINT, 0.3, "[1/", 120});
+  // 6 runs of 12 evaluations (about 5 s on a quiet machine): the signal comes after the first run
+  // ends, whatever the machine's speed, so it always lands while the comparison is working
   expect_stopped(r, 130, "compare SIGINT");
   EXPECT_HAS(r.output, "computed evaluations in");
   EXPECT_FALSE(fs::exists(out / "runs.csv"));
