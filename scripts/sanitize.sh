@@ -55,7 +55,7 @@ asan_build() {
 asan_slow="QuantisedReference[.]RandomStartsOfTheStudyProfilesAllFinish|SaoSampling[.]FewerSimulationsThanFixedSizeOnNoisyBenchmarks|SaoGlobal[.]Hs071FromRandomStartsReachesTheGlobalOptimum|Noisy/SaoConvergence[.]ReachesBestKnown/noisy_(hs071|cantilever)( |$)"
 asan_test() {
   ASAN_OPTIONS=detect_leaks=1:strict_string_checks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    ctest --test-dir build-asan -LE long -E "_NOT_BUILT$|Cli([.]|$)|^package_|$asan_slow" \
+    ctest --test-dir build-asan -LE "long|package" -E "_NOT_BUILT$|Cli([.]|$)|^package_|$asan_slow" \
     --output-on-failure -j "$jobs"
 }
 
