@@ -106,12 +106,14 @@ std::string study_html(const StudyFile& f, const StudyResult& r) {
   prof.push_back(speed_series(f.base.setup.profile, "baseline", "#444444", 2.0, true));
   std::size_t colour = 0;
   for (std::size_t i = 0; i < r.designs.size(); ++i) {
-    const bool is_rec = r.recommended && *r.recommended == i;
-    prof.push_back(speed_series(r.designs[i].profile, r.designs[i].label + (is_rec ? " (recommended)" : ""),
-                                is_rec ? "#d62728" : palette(colour == 0 ? 0 : colour + 1), is_rec ? 3.0 : 1.2,
+    if (r.recommended && *r.recommended == i) continue;  // drawn last, on top (a stage may end on the same design)
+    prof.push_back(speed_series(r.designs[i].profile, r.designs[i].label, palette(colour == 0 ? 0 : colour + 1), 1.2,
                                 false));
-    if (!is_rec) ++colour;  // palette(1) is the recommended design's red
+    ++colour;  // palette(1) is the recommended design's red
   }
+  if (r.recommended)
+    prof.push_back(speed_series(r.designs[*r.recommended].profile, r.designs[*r.recommended].label + " (recommended)",
+                                "#d62728", 3.0, false));
   h << "<h2>Profiles</h2>\n<figure>" << svg_line_chart("Disc speed against time", "time [s]", "speed [Hz]", prof, 900, 420)
     << "<figcaption>The recommended design (thick red), the baseline (dashed grey) and every stage's best design. "
     << "Natural frequency of the ABU as given: " << sig3(f.base.setup.abu.natural_frequency_hz()) << " Hz.</figcaption></figure>\n";
@@ -136,14 +138,14 @@ std::string study_html(const StudyFile& f, const StudyResult& r) {
         {"recommended (" + std::to_string(v.final_design.size()) + " runs)", "#d62728", v.final_design, false}};
     h << "<h2>Final ball positions over the equilibrium set</h2>\n<figure>"
       << svg_points_over_set("Final angles of the two balls", "beta_1 [deg]", "beta_2 [deg]", v.eq_n, v.eq_in_set,
-                             "equilibrium set at " + sig3(v.eq_frequency_hz) + " Hz, mu " + sig3(v.eq_mu) + " (" +
-                                 sig3(100.0 * static_cast<double>(std::count(v.eq_in_set.begin(), v.eq_in_set.end(), 1)) /
-                                      static_cast<double>(std::max<std::size_t>(1, v.eq_in_set.size()))) +
-                                 " % of the torus)",
+                             "equilibrium set (" + sig3(v.eq_frequency_hz) + " Hz, mu " + sig3(v.eq_mu) + ")",
                              groups)
       << "<figcaption>Where the balls stop, on the first fresh sample of the validation (the envelope's draws per run). "
          "Shaded: the configurations in which both balls can stay stuck at the last frequency with the nominal "
-         "friction (report section 4.2); the balancing positions lie where the residual imbalance vanishes."
+         "friction (report section 4.2), "
+      << sig3(100.0 * static_cast<double>(std::count(v.eq_in_set.begin(), v.eq_in_set.end(), 1)) /
+              static_cast<double>(std::max<std::size_t>(1, v.eq_in_set.size())))
+      << " % of the torus; the balancing positions lie where the residual imbalance vanishes."
          "</figcaption></figure>\n";
   }
 
