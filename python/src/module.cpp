@@ -20,6 +20,7 @@
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/config_sections.hpp"
 #include "bindings.hpp"  // register_module_extras, register_archive
+#include "interruptible.hpp"  // run_interruptible: long calls that Ctrl-C stops
 #include "abuopt/common/stop.hpp"
 #include "abuopt/common/text.hpp"
 #include "abuopt/core/batch_runner.hpp"
@@ -40,51 +41,6 @@ namespace abuopt::python {
 namespace {
 
 using Array = py::array_t<double>;
-
-// Runs `work` (no Python inside) on a worker thread while the calling thread, the GIL released
-// between polls, checks Python's signals every 50 ms: Ctrl-C (KeyboardInterrupt, or whatever a
-// SIGINT handler of the program raises) sets abuopt's stop request (abuopt/common/stop.hpp), the
-// Monte Carlo stops between runs (its work is thrown away), and the Python exception is raised
-// here within about a second instead of after the whole run. The stop request is process-wide:
-// calls running at the same time in other Python threads stop too.
-template <class Work>
-void run_interruptible(Work&& work) {
-  std::mutex m;
-  std::condition_variable cv;
-  bool done = false;
-  std::exception_ptr error;
-  std::thread worker([&] {
-    try {
-      work();
-    } catch (...) {
-      error = std::current_exception();
-    }
-    const std::lock_guard<std::mutex> lock(m);
-    done = true;
-    cv.notify_one();
-  });
-  bool interrupted = false;
-  while (true) {
-    {
-      py::gil_scoped_release release;
-      std::unique_lock<std::mutex> lock(m);
-      if (cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return done; })) break;
-    }
-    if (!interrupted && PyErr_CheckSignals() != 0) {  // the Python error (KeyboardInterrupt) is set
-      interrupted = true;
-      request_stop(SIGINT);
-    }
-  }
-  {
-    py::gil_scoped_release release;
-    worker.join();
-  }
-  if (interrupted) {
-    clear_stop();
-    throw py::error_already_set();
-  }
-  if (error) std::rethrow_exception(error);
-}
 
 // Initial angles and other per-call numbers from Python: finite, as the command line requires.
 void require_finite(const std::vector<double>& v, const std::string& key) {

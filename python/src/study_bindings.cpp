@@ -38,6 +38,7 @@
 #include "abuopt/studies/sweep.hpp"
 #include "bindings.hpp"
 #include "convert.hpp"
+#include "interruptible.hpp"
 
 namespace py = pybind11;
 namespace fs = std::filesystem;
@@ -48,51 +49,6 @@ namespace {
 
 using Array = py::array_t<double>;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-// Runs `work` (no Python inside) on a worker thread while this thread, the GIL released between
-// polls, checks Python's signals every 50 ms. On a signal (Ctrl-C: KeyboardInterrupt is set) `stop`
-// and the process's stop request are set, the library stops at its next safe point (the running
-// evaluation's Monte Carlo between runs, not recorded), and the Python exception is raised here.
-// (module.cpp's run_interruptible does the same for one Monte Carlo.)
-template <class Work>
-void run_stoppable(std::atomic<bool>& stop, Work&& work) {
-  std::mutex m;
-  std::condition_variable cv;
-  bool done = false;
-  std::exception_ptr error;
-  std::thread worker([&] {
-    try {
-      work();
-    } catch (...) {
-      error = std::current_exception();
-    }
-    const std::lock_guard<std::mutex> lock(m);
-    done = true;
-    cv.notify_one();
-  });
-  bool interrupted = false;
-  while (true) {
-    {
-      py::gil_scoped_release release;
-      std::unique_lock<std::mutex> lock(m);
-      if (cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return done; })) break;
-    }
-    if (!interrupted && PyErr_CheckSignals() != 0) {  // the Python error (KeyboardInterrupt) is set
-      interrupted = true;
-      stop.store(true);
-      request_stop(SIGINT);  // the process's stop request (common/stop.hpp): a Monte Carlo stops between runs
-    }
-  }
-  {
-    py::gil_scoped_release release;
-    worker.join();
-  }
-  if (interrupted) {
-    clear_stop();  // the next call starts afresh
-    throw py::error_already_set();
-  }
-  if (error) std::rethrow_exception(error);
-}
 
 template <typename T>
 void set_key(YAML::Node root, const char* section, const char* key, const std::optional<T>& value) {
@@ -218,7 +174,7 @@ py::object optimize(const py::handle& config, std::optional<long long> max_evalu
   opt::OptimizerOptions options = opt::read_optimizer_options(optimizer, &sao);
   finish_config(root);
   options.validate();
-  options.handle_sigint = false;  // Python's own handler sees Ctrl-C (run_stoppable)
+  options.handle_sigint = false;  // Python's own handler sees Ctrl-C (run_interruptible)
 
   OptimizeRun run(std::move(settings), std::move(options));
   const Output output(out);
@@ -229,10 +185,10 @@ py::object optimize(const py::handle& config, std::optional<long long> max_evalu
   std::atomic<bool> stop{false};
   opt::OptimizationResult r;
   std::optional<OutOfSampleComparison> cmp;
-  run_stoppable(stop, [&] {
+  run_interruptible([&] {
     r = run.minimize([&](const opt::Progress&) { return !stop.load(); });
     if (validate && !r.x.empty() && st.validation.enabled && !stop.load()) cmp = run.compare_out_of_sample(r);
-  });
+  }, &stop);
 
   py::dict d;
   d["x"] = vec(r.x);
@@ -334,7 +290,7 @@ py::object sweep(const py::handle& config, const std::optional<py::object>& out,
 
   std::atomic<bool> stop{false};
   SweepResult r;
-  run_stoppable(stop, [&] { r = run_sweep(problem, archive, plan, {}, &stop, options.constraint_tolerance); });
+  run_interruptible([&] { r = run_sweep(problem, archive, plan, {}, &stop, options.constraint_tolerance); }, &stop);
 
   const std::size_t n = r.points.size(), ng = problem.inequality_names().size();
   std::vector<std::vector<double>> xs, gs, unit;
@@ -407,17 +363,17 @@ py::object pareto(const py::handle& config, const std::optional<py::object>& out
   const ParetoSettings ps = read_pareto_settings(root.child("pareto"));
   finish_config(root);
   options.validate();
-  options.handle_sigint = false;  // Python's own handler sees Ctrl-C (run_stoppable)
+  options.handle_sigint = false;  // Python's own handler sees Ctrl-C (run_interruptible)
   const problems::StartupProfileProblem shape(settings);  // validates; names and labels
   const auto vars = shape.variables();
 
   const Output output(out);
   std::atomic<bool> stop{false};
   ParetoResult r;
-  run_stoppable(stop, [&] {
+  run_interruptible([&] {
     r = run_pareto(settings, options, ps, output.archive, l.config, l.hash,
                    [&](std::size_t, std::size_t, const opt::Progress&) { return !stop.load(); }, validate);
-  });
+  }, &stop);
 
   const std::size_t n = r.points.size();
   std::vector<std::vector<double>> xs;
