@@ -2,6 +2,8 @@
 // and durations) by Monte Carlo on common random numbers, with an evaluation archive so that a
 // rerun of the same command resumes; then checks the best design out of sample against the
 // report's final profile. docs/optimize.md describes every key and output.
+#include <cctype>
+#include <utility>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -418,7 +420,27 @@ int run_optimize(const OptimizeArgs& a) {
   }
   if (!r.has_feasible_point()) {
     std::cerr << "abuopt: no feasible design found in " << r.evaluations
-              << " evaluations (every design violates a constraint or failed; see the table above)\n";
+              << " evaluations (every design violates a constraint or failed)";
+    if (!r.x.empty()) {  // the result holds the least-violating design: name what it breaks
+      std::cerr << "; the least-violating design breaks";
+      const char* sep = " ";
+      for (std::size_t i = 0; i < g_names.size() && i < r.inequality.size(); ++i)
+        if (r.inequality[i] > 0) std::cerr << std::exchange(sep, ", ") << g_names[i] << " (g = " << format_significant(r.inequality[i], 3) << " > 0)";
+    }
+    // free frequencies whose bounds cannot reach this ABU's resonance (bounds set for another ABU)
+    const double fn = st.study.setup.abu.natural_frequency_hz();
+    std::string freq_bounds;
+    bool reaches = false;
+    for (const opt::Variable& v : vars)
+      if (v.name.size() > 1 && v.name[0] == 'f' && std::isdigit(static_cast<unsigned char>(v.name[1]))) {
+        freq_bounds += (freq_bounds.empty() ? "" : ", ") + v.name + " in [" + format_number(v.lower) + ", " +
+                       format_number(v.upper) + "] Hz";
+        if (v.lower <= fn && fn <= v.upper) reaches = true;
+      }
+    if (!freq_bounds.empty() && !reaches)
+      std::cerr << "; no free frequency can reach this ABU's natural frequency " << format_significant(fn, 4)
+                << " Hz (" << freq_bounds << "): the design's bounds may be set for another ABU";
+    std::cerr << "\n";
     return 3;
   }
   return 0;

@@ -144,3 +144,24 @@ TEST(OptimizeCli, BadConfigsGiveOneClearMessageAndStatus2) {
   EXPECT_EQ(missing.status, 2);
   EXPECT_NE(missing.output.find("cannot be opened"), std::string::npos) << missing.output;
 }
+
+// A design made for the report's ABU run on a stiffer one (k = 4e4 N/m: f_n 55.85 Hz, outside the
+// frequency bounds [15, 30.5] Hz of f1_k4_hold.yaml): the message names the constraints the
+// least-violating design breaks and says that no free frequency reaches the natural frequency.
+TEST(OptimizeCli, NoFeasibleDesignNamesTheConstraintsAndTheUnreachableResonance) {
+  std::ifstream in(std::string(ABUOPT_SOURCE_DIR) + "/configs/studies/f1_k4_hold.yaml");
+  std::string text, line;
+  while (std::getline(in, line)) {
+    text += line + "\n";
+    if (line == "abu:") text += "  stiffness_N_per_m: 4.0e4\n";
+  }
+  const std::string cfg = write_config("stiff_abu.yaml", text);
+  const fs::path out = fresh_dir("stiff_abu");
+  const Result r = run("optimize " + cfg + " --out " + out.string() + " --max-evaluations 3");
+  EXPECT_EQ(r.status, 3) << r.output;
+  EXPECT_NE(r.output.find("the least-violating design breaks"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("(g = "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("no free frequency can reach this ABU's natural frequency 55.85 Hz"), std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("see the table above"), std::string::npos) << r.output;
+}
