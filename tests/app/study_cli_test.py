@@ -8,10 +8,15 @@
   study_cli_test.py ABUOPT browser  the tiny study's report.html in headless Chromium: no console
                                     error, every inline figure rendered with a non-zero size
                                     (exit 77 = skipped when chromium is not installed)
+  study_cli_test.py ABUOPT check    every study file under configs/studies/ (a YAML file with `stages:`
+                                    and `family:`, so files added later are checked too) passes
+                                    `--check` (exit 0, the plan printed, nothing written); bad files fail
+                                    with exit 2 naming the key
   study_cli_test.py ABUOPT quick    configs/studies/quick.yaml end to end (<= 2 min on 2 cores), killed
                                     with SIGKILL part way and resumed, and interrupted with SIGINT and
                                     resumed: the same summary as a run that was never interrupted
 """
+import glob
 import json
 import os
 import re
@@ -256,4 +261,62 @@ def mode_quick():
         shutil.rmtree(tmp, ignore_errors=True)
 
 
-{"tiny": mode_tiny, "browser": mode_browser, "quick": mode_quick}[MODE]()
+def study_files():
+    """Every `abuopt study` file under configs/studies/ (the `abuopt optimize` configs there have no `stages:`)."""
+    out = []
+    for path in sorted(glob.glob(os.path.join("configs", "studies", "**", "*.yaml"), recursive=True)):
+        text = open(path).read()
+        if re.search(r"^stages:", text, re.M) and re.search(r"^family:", text, re.M):
+            out.append(path)
+    return out
+
+
+def mode_check():
+    files = study_files()
+    if QUICK not in files:
+        fail(f"the glob found {files}, not {QUICK}")
+    tmp = tempfile.mkdtemp(prefix="abuopt_study_check_")
+    try:
+        for path in files:
+            t0 = time.time()
+            p = run(["study", path, "--check", "--out", os.path.join(tmp, "never")])
+            for want in ("the file is valid", "natural frequency f_n", "free variables", "stages:", "budget:",
+                         "estimate: at most"):
+                if want not in p.stdout:
+                    fail(f"--check of {path} lacks '{want}':\n{p.stdout}")
+            if os.path.exists(os.path.join(tmp, "never")):
+                fail(f"--check of {path} wrote its output directory")
+            if time.time() - t0 > 10:
+                fail(f"--check of {path} took {time.time() - t0:.1f} s: it must not simulate")
+        # the quick study's plan: f_n of the report's ABU, bounds converted to Hz, the estimate
+        p = run(["study", QUICK, "--check"])
+        if "f_n = sqrt(k/M)/2pi = 28.89 Hz" not in p.stdout or "f2 in [28.019, 31.774] Hz" not in p.stdout:
+            fail("the quick study's plan:\n" + p.stdout)
+        # 64 runs x (1 baseline + 60 optimiser evaluations) + 3 x 2 x 64 + 2 x 4 x 256 + 2 x 9 x 64 + 2 x 256
+        if "estimate: at most 8,000 simulations" not in p.stdout:
+            fail("the quick study's estimate:\n" + p.stdout)
+        # bounds in Hz that cannot reach f_n: a warning, still exit 0
+        hz = os.path.join(tmp, "hz.yaml")
+        open(hz, "w").write(open(QUICK).read().replace("frequency_unit: natural", "frequency_unit: hz"))
+        p = run(["study", hz, "--check"])
+        if "warning: 2 balls: the family cannot reach the resonance" not in p.stdout:
+            fail("no resonance warning:\n" + p.stdout)
+        # bad files: exit 2, the key, the value and the rule named, as a run says it
+        for old, new, want in [
+                ("kind: validate", "kind: check", "stages[3].kind = check"),
+                ("runs: 64, seed: 21", "runs: -3, seed: 21", "runs = -3"),
+                ("algorithm: direct_l", "algorithm: nosuch", "nosuch"),
+                ("max_pct_mi: 100", "max_pct_mi: 100\n  max_speed: 3", "constraints.max_speed")]:
+            bad = os.path.join(tmp, "bad.yaml")
+            text = open(QUICK).read()
+            assert old in text, old
+            open(bad, "w").write(text.replace(old, new, 1))
+            p = run(["study", bad, "--check"], expect=2)
+            if want not in p.stderr:
+                fail(f"bad file ({new}): the message does not name '{want}':\n{p.stderr}")
+        print(f"ok: --check passes {len(files)} study files ({', '.join(files)}); bad files exit 2 naming the key")
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+{"tiny": mode_tiny, "browser": mode_browser, "quick": mode_quick, "check": mode_check}[MODE]()

@@ -85,6 +85,18 @@ problems::StartupProfileSettings settings_of_choice(const StudyFile& f, std::siz
 // Which free end frequencies can reach f_n (Hz); empty message when one can.
 std::string resonance_reach_text(const problems::ProfileDesign& d, double natural_frequency_hz);
 
+// The plan of a study (`abuopt study FILE --check`): counts from the file alone, nothing simulated.
+struct StudyPlan {
+  long long runs_per_evaluation = 0;    // sampling.runs x the robust friction values (if any)
+  long long optimiser_evaluations = 0;  // min(the optimiser stages' budgets x choices, budget.max_evaluations)
+  long long simulations = 0;            // an upper estimate of the simulations of the whole study
+  std::vector<std::string> warnings;    // the family cannot reach the resonance, ...
+};
+StudyPlan plan_of(const StudyFile& f);
+// The plan as text for a person: f_n, the free variables with bounds in Hz (after natural units),
+// the choices, each stage with its optimiser and budget, runs per evaluation, the estimate, warnings.
+std::string plan_text(const StudyFile& f);
+
 // One evaluated design (a point of one stage).
 struct StudyDesign {
   std::string label;          // "balls2_local" ...
