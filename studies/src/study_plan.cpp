@@ -22,8 +22,12 @@ std::string rounded(double v, int decimals) {
 
 // "12,345,678"
 std::string grouped(long long n) {
-  std::string s = std::to_string(n);
-  for (int i = static_cast<int>(s.size()) - 3; i > 0; i -= 3) s.insert(static_cast<std::size_t>(i), ",");
+  const std::string digits = std::to_string(n);
+  std::string s;
+  for (std::size_t i = 0; i < digits.size(); ++i) {
+    if (i > 0 && (digits.size() - i) % 3 == 0) s.push_back(',');
+    s.push_back(digits[i]);
+  }
   return s;
 }
 
@@ -44,12 +48,16 @@ StudyPlan plan_of(const StudyFile& f) {
   for (const StageSpec& s : f.stages)
     if (s.kind == StageKind::Global || s.kind == StageKind::Local)
       optimiser += s.optimizer.max_evaluations * static_cast<long long>(choices);
+    else if (s.kind == StageKind::Pareto)
+      optimiser += s.optimizer.max_evaluations * static_cast<long long>(choices * s.pareto_bounds.size());
   p.optimiser_evaluations = std::min<long long>(optimiser, f.max_evaluations);
   p.simulations += p.optimiser_evaluations * runs;
   for (const StageSpec& s : f.stages) {
     const long long stage_runs = (s.runs ? static_cast<long long>(s.runs) : static_cast<long long>(f.base.runs)) * robust;
     const long long seeds = static_cast<long long>(s.seeds.size());
-    if (s.kind == StageKind::Replicate) {
+    if (s.kind == StageKind::Pareto) {  // each front point and the baseline on every fresh sample
+      p.simulations += seeds * static_cast<long long>(choices * s.pareto_bounds.size() + 1) * stage_runs;
+    } else if (s.kind == StageKind::Replicate) {
       p.simulations += seeds * static_cast<long long>(choices + 1) * stage_runs;
     } else if (s.kind == StageKind::Validate) {
       p.simulations += 2 * seeds * stage_runs;
@@ -108,7 +116,15 @@ std::string plan_text(const StudyFile& f) {
   os << "stages:\n";
   for (const StageSpec& s : f.stages) {
     os << "  " << s.name << " (" << to_string(s.kind) << "): ";
-    if (s.kind == StageKind::Global || s.kind == StageKind::Local) {
+    if (s.kind == StageKind::Pareto) {
+      os << "the front of the objective against T <=";
+      for (std::size_t i = 0; i < s.pareto_bounds.size(); ++i) os << (i ? ", " : " ") << format_number(s.pareto_bounds[i]);
+      os << " s; " << s.optimizer.algorithm << ", at most " << s.optimizer.max_evaluations
+         << " evaluations per bound and choice";
+      if (!s.seeds.empty())
+        os << "; each point on " << s.seeds.size() << " fresh samples of " << (s.runs ? s.runs : f.base.runs) << " runs";
+      os << "\n";
+    } else if (s.kind == StageKind::Global || s.kind == StageKind::Local) {
       os << s.optimizer.algorithm << ", at most " << s.optimizer.max_evaluations << " evaluations per choice, from "
          << (s.kind == StageKind::Global ? "the family's x0" : "the best so far (the family's x0 if none)") << "\n";
     } else {
