@@ -147,8 +147,8 @@ std::string markdown(const StudyFile& f, const StudyResult& r) {
       md << "On " << v.seeds.size() << " fresh samples of " << v.runs
          << " runs over the envelope (mean and 95 % interval over the samples):\n\n"
          << "| | recommended | baseline |\n|---|---|---|\n";
-      const std::pair<const char*, const char*> rows[] = {{"ir_magnitude_mean", "mean |I_r| [1e-7 kg m]"},
-                                                         {"ir_magnitude_max", "max |I_r| [1e-7 kg m]"},
+      const std::pair<const char*, const char*> rows[] = {{"ir_magnitude_mean", "mean \\|I_r\\| [1e-7 kg m]"},
+                                                         {"ir_magnitude_max", "max \\|I_r\\| [1e-7 kg m]"},
                                                          {"pct_mi", "%MI"},
                                                          {"amplitude_max_mm", "peak amplitude [mm]"}};
       for (const auto& [k, label] : rows)
@@ -162,7 +162,7 @@ std::string markdown(const StudyFile& f, const StudyResult& r) {
     for (const auto& n : r.notes) md << "- " << n << "\n";
     md << "\n";
   }
-  md << "## Designs\n\n| design | balls | stage | objective (in sample) | objective (replicated) | feasible | mean |I_r| | "
+  md << "## Designs\n\n| design | balls | stage | objective (in sample) | objective (replicated) | feasible | mean \\|I_r\\| | "
         "%MI | peak amplitude [mm] | T [s] | profile |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
   md << "| baseline | " << f.base.setup.abu.balls.size() << " | - | " << sig3(r.baseline.objective) << " | - | "
      << (feasible(r.baseline) ? "yes" : "no") << " | " << sig3(metric(r.baseline, "ir_magnitude_mean")) << " | "
@@ -183,7 +183,7 @@ std::string markdown(const StudyFile& f, const StudyResult& r) {
        << (oos ? "in sample and on " + std::to_string(fr.seeds.size()) + " fresh samples of " + std::to_string(fr.runs) +
                      " runs (mean and 95 % interval).\n\n"
                : "in sample only (biased low: the optimiser chose on that sample).\n\n")
-       << "| bound on T [s] | balls | T [s] | mean |I_r| in sample | " << (oos ? "mean |I_r| fresh | feasible fresh | " : "")
+       << "| bound on T [s] | balls | T [s] | mean \\|I_r\\| in sample | " << (oos ? "mean \\|I_r\\| fresh | feasible fresh | " : "")
        << "%MI | feasible | dominated | config |\n|---|---|---|---|" << (oos ? "---|---|" : "") << "---|---|---|---|\n";
     for (const FrontPoint& p : fr.points) {
       md << "| " << sig3(p.bound_s) << " | " << p.design.balls << " | " << sig3(p.design.profile.duration_s()) << " | "

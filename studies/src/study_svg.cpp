@@ -89,6 +89,13 @@ std::string svg_line_chart(const std::string& title, const std::string& x_label,
     return o.str();
   }
   if (!(x1 > x0)) x1 = x0 + 1;
+  bool dots = false;  // dots at the ends of the x range would be cut by the frame: pad it
+  for (const SvgSeries* s : shown) dots = dots || s->markers || s->width <= 0;
+  if (dots) {
+    const double pad = 0.03 * (x1 - x0);
+    x0 -= pad;
+    x1 += pad;
+  }
   if (!(y1 > y0)) {
     const double pad = std::max(std::fabs(y0) * 0.05, 1e-9);
     y0 -= pad;
