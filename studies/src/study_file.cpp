@@ -121,7 +121,10 @@ void check_stage_order(std::vector<StageSpec>& stages, const std::string& path) 
   for (std::size_t i = 0; i < stages.size(); ++i) {
     int n = 1;
     for (std::size_t j = 0; j < i; ++j) n += stages[j].name == stages[i].name;
-    if (n > 1) stages[i].name += "_" + std::to_string(n);
+    if (n > 1) {
+      stages[i].name += '_';
+      stages[i].name += std::to_string(n);
+    }
   }
 }
 
