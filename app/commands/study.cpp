@@ -35,7 +35,7 @@ int run_study_command(const StudyArgs& a) {
   }
   const std::string out = a.out.empty() ? "results/" + std::filesystem::path(a.file).stem().string() : a.out;
   const OutputDirLock lock(out);
-  std::cout << "study " << a.file << " (" << f.title << "): " << f.ball_counts.size() << " choice(s), "
+  std::cout << "study " << a.file << " (" << f.title << "): " << f.choices.size() << " choice(s), "
             << f.stages.size() << " stages, budget " << f.max_evaluations << " evaluations, " << f.base.runs
             << " runs per evaluation; output " << out << "\n"
             << std::flush;

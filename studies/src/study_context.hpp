@@ -2,7 +2,9 @@
 // What the stages of a study share (studies/src/study_runner.cpp builds it; one file per stage
 // kind: study_stage_global.cpp, study_stage_local.cpp, study_stage_replicate.cpp,
 // study_stage_validate.cpp).
+#include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,13 +15,26 @@ namespace abuopt::studies::detail {
 
 // One discrete choice (a ball count): its problem, archived, and where the next stage starts.
 struct ChoiceContext {
-  std::size_t balls = 0;
+  std::size_t index = 0;   // into StudyFile::choices
+  std::string label;       // "balls2", a set's name
+  std::size_t balls = 0;   // its ball count
+  bool active = true;      // choices.balls.mode: variable: false until a global stage chooses this count
   std::unique_ptr<problems::StartupProfileProblem> problem;
   std::unique_ptr<opt::EvaluationArchive> archive;
   std::unique_ptr<opt::ArchivedProblem> archived;
   std::vector<double> x;                 // the best design so far (empty: the family's x0)
   std::optional<std::size_t> last_design;  // the best design so far: index into StudyResult::designs
   std::vector<double> least_violation;   // per constraint: the smallest g_i seen (for "cannot be met")
+};
+
+// choices.balls.mode: variable: the problem with the ball count free (the global stages').
+struct VariableCountContext {
+  std::unique_ptr<problems::StartupProfileProblem> problem;
+  std::unique_ptr<opt::EvaluationArchive> archive;
+  std::unique_ptr<opt::ArchivedProblem> archived;
+  std::map<std::size_t, long> evaluations;    // per count: the global stages' evaluations there
+  std::map<std::size_t, double> best;         // per count: the best feasible objective (absent: none)
+  std::vector<double> least_violation;
 };
 
 struct StudyContext {
@@ -32,6 +47,7 @@ struct StudyContext {
   long total = 0;    // progress units planned
   bool interrupted = false;  // an optimiser stopped on SIGINT (its own handler ran, not the caller's)
   std::vector<ChoiceContext> choices;
+  std::optional<VariableCountContext> variable;  // choices.balls.mode: variable
 
   void log(const std::string& line) const;
   bool stop() const;
@@ -43,7 +59,7 @@ struct StudyContext {
     problems::StartupProfileSettings settings;
     opt::Evaluation baseline;
   };
-  Fresh fresh(std::size_t balls, std::uint64_t seed, std::size_t runs);
+  Fresh fresh(std::size_t choice, std::uint64_t seed, std::size_t runs);
   // The baseline's settings on a sample (seed, runs; 0: keep).
   problems::StartupProfileSettings baseline_sample(std::uint64_t seed, std::size_t runs) const;
   // Evaluates a profile under `s` through the archive (key: the problem identity and the profile).
@@ -61,7 +77,7 @@ struct OptimiserRun {
   StageTrace trace;
 };
 OptimiserRun run_archived_optimiser(StudyContext& c, const StageSpec& stage, const std::string& trace_name,
-                                    std::size_t balls, problems::StartupProfileProblem& problem,
+                                    const ChoiceContext* choice, problems::StartupProfileProblem& problem,
                                     opt::ArchivedProblem& archived, long max_evaluations, const std::vector<double>& x0,
                                     std::vector<double>& least_violation);
 // A design of the study at x of `problem` (its in-sample evaluation from the archive).

@@ -34,11 +34,11 @@ void final_positions(StudyContext& c, const StudyDesign& d, std::uint64_t seed, 
     c.log("final positions: drawn for two balls only");
     return;
   }
-  const StudyContext::Fresh fr = c.fresh(d.balls, seed, runs);
+  const StudyContext::Fresh fr = c.fresh(d.choice, seed, runs);
   const std::size_t threads = fr.settings.threads;
   v.final_design = final_angles_deg(fr.settings.study, d.profile, threads);
   v.final_baseline = final_angles_deg(c.baseline_sample(seed, runs).study, c.file.base.setup.profile, threads);
-  const AbuParameters abu = abu_of_choice(c.file, d.balls);
+  const AbuParameters abu = abu_of_choice(c.file, d.choice);
   const EquilibriumSet set(abu, abu.friction_mu);
   v.eq_frequency_hz = d.profile.segments().back().end_frequency_hz;
   v.eq_mu = abu.friction_mu;

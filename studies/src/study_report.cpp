@@ -67,6 +67,31 @@ std::string verdict_text(const ValidationResult& v) {
   return "No difference from the baseline that " + n + " can tell (the 95 % interval of the ratio contains 1).";
 }
 
+std::string choices_sentence(const StudyFile& f, const StudyResult& r) {
+  std::ostringstream os;
+  const std::string won = r.recommended ? choice_name(f.choices[r.designs[*r.recommended].choice]) : "";
+  if (f.ball_count_variable) {
+    os << "The ball count was a variable of the global stages (";
+    for (std::size_t i = 0; i < r.choice_summary.size(); ++i)
+      os << (i ? ", " : "") << r.choice_summary[i].balls;
+    os << " balls at " << sig3(f.total_ball_mass_kg.value_or(0)) << " kg in all); they chose";
+    bool any = false;
+    for (const auto& cs : r.choice_summary)
+      if (cs.chosen) {
+        os << (any ? " and " : " ") << cs.balls << " balls";
+        any = true;
+      }
+    if (!any) os << " none";
+    os << ", which the later stages polished.";
+  } else {
+    os << "Every choice was optimised with the same stages";
+    if (f.total_ball_mass_kg) os << " (counts at " << sig3(*f.total_ball_mass_kg) << " kg in all)";
+    os << ".";
+  }
+  if (!won.empty()) os << " The recommended design has " << won << ".";
+  return os.str();
+}
+
 }  // namespace detail
 
 namespace {
@@ -106,7 +131,7 @@ std::string indent(const std::string& text, const std::string& pad) {
 
 std::string design_yaml(const StudyFile& f, const StudyResult& r, const StudyDesign& d) {
   SimulationSetup setup = f.base.setup;
-  setup.abu = abu_of_choice(f, d.balls);
+  setup.abu = abu_of_choice(f, d.choice);
   setup.profile = d.profile;
   MonteCarloConfig mc;
   mc.study = f.base;
@@ -157,6 +182,20 @@ std::string markdown(const StudyFile& f, const StudyResult& r) {
          << verdict_text(v) << "\n\n";
     }
   }
+  if (r.choice_summary.size() > 1) {
+    md << "## Ball choices\n\n" << choices_sentence(f, r) << "\n\n| choice | balls | total ball mass [kg] | diameters [mm] | "
+       << "evaluations | best feasible objective in sample |" << (f.ball_count_variable ? " polished |" : "")
+       << "\n|---|---|---|---|---|---|" << (f.ball_count_variable ? "---|" : "") << "\n";
+    for (std::size_t i = 0; i < r.choice_summary.size(); ++i) {
+      const auto& cs = r.choice_summary[i];
+      double mass = 0;
+    for (const Ball& b : f.choices[i].balls) mass += b.mass_kg;
+      md << "| " << cs.label << " | " << cs.balls << " | " << sig3(mass) << " | " << diameters_mm(f.choices[i].balls) << " | "
+         << cs.evaluations << " | " << (std::isfinite(cs.best_feasible) ? sig3(cs.best_feasible) : "none feasible")
+         << " |" << (f.ball_count_variable ? (cs.chosen ? " yes |" : " no |") : "") << "\n";
+    }
+    md << "\n";
+  }
   if (!r.notes.empty()) {
     md << "## Notes\n\n";
     for (const auto& n : r.notes) md << "- " << n << "\n";
@@ -197,9 +236,9 @@ std::string markdown(const StudyFile& f, const StudyResult& r) {
     if (oos) md << interval_text(fr.baseline_out_of_sample_ir) << " | - | ";
     md << sig3(metric(r.baseline, "pct_mi")) << " | - | - | - |\n";
   }
-  md << "\n## Stages\n\n| stage | balls | algorithm | reason | evaluations | from archive |\n|---|---|---|---|---|---|\n";
+  md << "\n## Stages\n\n| stage | choice | algorithm | reason | evaluations | from archive |\n|---|---|---|---|---|---|\n";
   for (const auto& t : r.traces)
-    md << "| " << t.stage << " | " << t.balls << " | " << t.algorithm << " | " << t.reason << " | " << t.evaluations
+    md << "| " << t.stage << " | " << (t.balls ? t.choice : std::string("ball count a variable")) << " | " << t.algorithm << " | " << t.reason << " | " << t.evaluations
        << " | " << t.archive_hits << " |\n";
   md << "\nObjective: " << to_string(f.objective.kind) << " (I_r in 1e-7 kg m); " << f.base.runs
      << " runs per evaluation on the same initial angles (common random numbers), seed " << f.base.seed
@@ -285,11 +324,22 @@ nlohmann::json summary(const StudyFile& f, const StudyResult& r) {
       j["pareto"]["baseline_out_of_sample_mean_abs_ir"] = interval_json(fr.baseline_out_of_sample_ir);
     }
   }
+  j["choices"] = nlohmann::json::array();
+  for (std::size_t i = 0; i < r.choice_summary.size(); ++i) {
+    const auto& cs = r.choice_summary[i];
+    nlohmann::json balls = nlohmann::json::array();
+    for (const Ball& b : f.choices[i].balls) balls.push_back({{"mass_kg", b.mass_kg}, {"diameter_m", b.diameter_m}});
+    j["choices"].push_back({{"label", cs.label}, {"balls", balls}, {"evaluations", cs.evaluations},
+                            {"best_feasible_objective", std::isfinite(cs.best_feasible) ? nlohmann::json(cs.best_feasible)
+                                                                                        : nlohmann::json(nullptr)},
+                            {"chosen", cs.chosen}});
+  }
+  j["ball_count_variable"] = f.ball_count_variable;
   j["traces"] = nlohmann::json::array();
   for (const auto& t : r.traces) {
     nlohmann::json best = nlohmann::json::array();
     for (double b : t.best_feasible) best.push_back(std::isfinite(b) ? nlohmann::json(b) : nlohmann::json(nullptr));
-    j["traces"].push_back({{"stage", t.stage}, {"balls", t.balls}, {"algorithm", t.algorithm}, {"reason", t.reason},
+    j["traces"].push_back({{"stage", t.stage}, {"choice", t.choice}, {"balls", t.balls}, {"algorithm", t.algorithm}, {"reason", t.reason},
                            {"evaluations", t.evaluations}, {"archive_hits", t.archive_hits}, {"best_feasible", best}});
   }
   return j;

@@ -44,6 +44,36 @@ figure{margin:1em 0} figcaption{font-size:0.9em;color:#444;max-width:720px}
 .small{font-size:0.85em;color:#555}
 )";
 
+// "2 balls", a set's name, or "ball count a variable" (a global stage over the count)
+std::string trace_who(const StageTrace& t) {
+  if (t.balls == 0) return "ball count a variable";
+  return t.choice == "balls" + std::to_string(t.balls) ? std::to_string(t.balls) + " balls" : t.choice;
+}
+
+std::string choices_html(const StudyFile& f, const StudyResult& r) {
+  std::ostringstream h;
+  h << "<h2>Ball choices</h2>\n<p>" << esc(choices_sentence(f, r)) << "</p>\n<table><tr><th>choice</th><th>balls</th>"
+    << "<th>total ball mass [kg]</th><th>diameters [mm]</th><th>"
+    << (f.ball_count_variable ? "evaluations of the global stages" : "optimiser evaluations")
+    << "</th><th>best feasible objective<br>in sample</th>" << (f.ball_count_variable ? "<th>polished</th>" : "")
+    << "</tr>\n";
+  for (std::size_t i = 0; i < r.choice_summary.size(); ++i) {
+    const auto& cs = r.choice_summary[i];
+    double mass = 0;
+    for (const Ball& b : f.choices[i].balls) mass += b.mass_kg;
+    const bool won = r.recommended && r.designs[*r.recommended].choice == i;
+    h << "<tr" << (won ? " style=\"font-weight:bold\"" : "") << "><td>" << esc(cs.label) << (won ? " (recommended)" : "")
+      << "</td><td class=\"num\">" << cs.balls << "</td><td class=\"num\">" << sig3(mass)
+      << "</td><td class=\"num\">" << diameters_mm(f.choices[i].balls) << "</td><td class=\"num\">" << cs.evaluations
+      << "</td><td class=\"num\">" << (std::isfinite(cs.best_feasible) ? sig3(cs.best_feasible) : "none feasible")
+      << "</td>";
+    if (f.ball_count_variable) h << "<td>" << (cs.chosen ? "yes" : "no") << "</td>";
+    h << "</tr>\n";
+  }
+  h << "</table>\n";
+  return h.str();
+}
+
 std::string pareto_html(const StudyFile& f, const StudyResult& r) {
   const ParetoFront& fr = r.front;
   const bool oos = !fr.seeds.empty();
@@ -51,10 +81,10 @@ std::string pareto_html(const StudyFile& f, const StudyResult& r) {
   std::vector<SvgSeries> series;
   std::vector<std::size_t> counts;
   for (const FrontPoint& p : fr.points)
-    if (std::find(counts.begin(), counts.end(), p.design.balls) == counts.end()) counts.push_back(p.design.balls);
+    if (std::find(counts.begin(), counts.end(), p.design.choice) == counts.end()) counts.push_back(p.design.choice);
   for (std::size_t k = 0; k < counts.size(); ++k) {
     SvgSeries in, out;
-    const std::string who = counts.size() > 1 ? std::to_string(counts[k]) + " balls, " : "";
+    const std::string who = counts.size() > 1 ? f.choices[counts[k]].label + ", " : "";
     in.name = who + "in sample (" + std::to_string(f.base.runs) + " runs)";
     out.name = who + "fresh samples (mean of " + std::to_string(fr.seeds.size()) + " x " + std::to_string(fr.runs) +
                " runs)";
@@ -62,7 +92,7 @@ std::string pareto_html(const StudyFile& f, const StudyResult& r) {
     in.markers = out.markers = true;
     out.dashed = true;
     for (const FrontPoint& p : fr.points) {
-      if (p.design.balls != counts[k] || !p.feasible) continue;
+      if (p.design.choice != counts[k] || !p.feasible) continue;
       in.x.push_back(p.design.profile.duration_s());
       in.y.push_back(metric(p.design.in_sample, "ir_magnitude_mean"));
       if (oos) {
@@ -167,6 +197,9 @@ std::string study_html(const StudyFile& f, const StudyResult& r) {
     h << "</ul></div>\n";
   }
 
+  // ---- how each ball choice did ----
+  if (r.choice_summary.size() > 1) h << choices_html(f, r);
+
   // ---- the profiles ----
   std::vector<SvgSeries> prof;
   {  // the natural frequency of the ABU as given, as a dotted level
@@ -238,8 +271,8 @@ std::string study_html(const StudyFile& f, const StudyResult& r) {
   for (std::size_t i = 0; i < r.traces.size(); ++i) {
     const StageTrace& t = r.traces[i];
     SvgSeries all, best;
-    all.name = t.stage + " (" + std::to_string(t.balls) + " balls): every evaluation";
-    best.name = t.stage + " (" + std::to_string(t.balls) + " balls): best feasible";
+    all.name = t.stage + " (" + trace_who(t) + "): every evaluation";
+    best.name = t.stage + " (" + trace_who(t) + "): best feasible";
     all.color = best.color = palette(i);
     all.width = 0.8;
     best.width = 2.5;
@@ -257,10 +290,10 @@ std::string study_html(const StudyFile& f, const StudyResult& r) {
                                     "objective (" + to_string(f.objective.kind) + ")", conv, 900, 460)
     << "<figcaption>Stages run in order; each optimiser stage starts from the previous best. The baseline's objective "
        "in sample is "
-    << sig3(r.baseline.objective) << ".</figcaption></figure>\n<table><tr><th>stage</th><th>balls</th><th>algorithm</th>"
+    << sig3(r.baseline.objective) << ".</figcaption></figure>\n<table><tr><th>stage</th><th>choice</th><th>algorithm</th>"
        "<th>reason</th><th>evaluations</th><th>from archive</th></tr>\n";
   for (const auto& t : r.traces)
-    h << "<tr><td>" << esc(t.stage) << "</td><td class=\"num\">" << t.balls << "</td><td>" << esc(t.algorithm)
+    h << "<tr><td>" << esc(t.stage) << "</td><td class=\"num\">" << esc(trace_who(t)) << "</td><td>" << esc(t.algorithm)
       << "</td><td>" << esc(t.reason) << "</td><td class=\"num\">" << t.evaluations << "</td><td class=\"num\">"
       << t.archive_hits << "</td></tr>\n";
   h << "</table>\n";

@@ -39,8 +39,11 @@ void run_pareto_stage(StudyContext& c, const StageSpec& stage) {
   ParetoFront& front = c.result.front;
   front.stage = stage.name;
   front.points.clear();
-  const bool several = c.choices.size() > 1;
+  std::size_t active = 0;
+  for (const ChoiceContext& ch : c.choices) active += ch.active;
+  const bool several = active > 1;
   for (ChoiceContext& ch : c.choices) {
+    if (!ch.active) continue;
     std::vector<double> x0 = ch.x;  // the best so far
     std::optional<std::size_t> previous;  // index of the previous bound's point (feasible)
     for (double bound : stage.pareto_bounds) {
@@ -50,26 +53,26 @@ void run_pareto_stage(StudyContext& c, const StageSpec& stage) {
       const long remaining = c.file.max_evaluations - c.used;
       if (remaining <= 0) {
         c.result.notes.push_back("stage " + stage.name + ": the bound " + tag + " skipped for " +
-                                 std::to_string(ch.balls) + " balls: the budget (budget.max_evaluations = " +
+                                 ch.label + ": the budget (budget.max_evaluations = " +
                                  std::to_string(c.file.max_evaluations) + ") is spent");
         c.log(c.result.notes.back());
         continue;
       }
-      problems::StartupProfileSettings s = settings_of_choice(c.file, ch.balls, c.result.baseline.metrics);
+      problems::StartupProfileSettings s = settings_of_choice(c.file, ch.index, c.result.baseline.metrics);
       if (c.options.threads) s.threads = *c.options.threads;
       s.constraints.max_startup_time_s = bound;
       problems::StartupProfileProblem problem(s);
       opt::EvaluationArchive archive(c.archive_path, problem.identity());
       opt::ArchivedProblem archived(problem, archive);
       std::vector<double> least(problem.inequality_names().size(), std::numeric_limits<double>::infinity());
-      OptimiserRun run = run_archived_optimiser(c, stage, stage.name + "_" + tag, ch.balls, problem, archived,
+      OptimiserRun run = run_archived_optimiser(c, stage, stage.name + "_" + tag, &ch, problem, archived,
                                                 remaining, x0, least);
       c.result.traces.push_back(run.trace);
       if (run.best_x.empty()) continue;
       FrontPoint p;
       p.bound_s = bound;
       p.design = design_at(ch, problem, archived,
-                           (several ? "balls" + std::to_string(ch.balls) + "_" : std::string()) + "pareto_" + tag,
+                           (several ? ch.label + "_" : std::string()) + "pareto_" + tag,
                            stage.name, run.best_x);
       p.feasible = feasible(p.design.in_sample);
       // a looser bound keeps the tighter bound's design when the optimiser found nothing better
@@ -100,7 +103,7 @@ void run_pareto_stage(StudyContext& c, const StageSpec& stage) {
     a.dominated = false;
     if (!a.feasible) continue;
     for (const FrontPoint& b : front.points) {
-      if (&a == &b || !b.feasible || a.design.balls != b.design.balls) continue;
+      if (&a == &b || !b.feasible || a.design.choice != b.design.choice) continue;
       const double ta = a.design.profile.duration_s(), tb = b.design.profile.duration_s();
       const double fa = mean_ir(a.design.in_sample), fb = mean_ir(b.design.in_sample);
       if (tb <= ta && fb <= fa && (tb < ta || fb < fa)) a.dominated = true;
@@ -116,7 +119,7 @@ void run_pareto_stage(StudyContext& c, const StageSpec& stage) {
     for (std::size_t i = 0; i < front.points.size(); ++i) {
       if (c.stop()) return;
       FrontPoint& p = front.points[i];
-      StudyContext::Fresh fr = c.fresh(p.design.balls, seed, stage.runs);
+      StudyContext::Fresh fr = c.fresh(p.design.choice, seed, stage.runs);
       if (i == 0) base.push_back(mean_ir(fr.baseline));
       front.runs = fr.settings.study.runs;
       fr.settings.constraints.max_startup_time_s = p.bound_s;

@@ -13,6 +13,11 @@
                                     report.md and report.html, T within each bound, the front's mean |I_r|
                                     not rising as the bound loosens, designs/pareto_T<bound>.yaml, a rerun
                                     from the archive with the same front
+  study_cli_test.py ABUOPT choices  the tiny study with the ball count a variable of the global stage
+                                    (2-4 balls at one total mass: the chosen count polished, how every count
+                                    did, the design file with those balls, a rerun from the archive) and
+                                    with two ball sets (each optimised, the winner named); bad choices
+                                    exit 2 naming the key
   study_cli_test.py ABUOPT check    every study file under configs/studies/ (a YAML file with `stages:`
                                     and `family:`, so files added later are checked too) passes
                                     `--check` (exit 0, the plan printed, nothing written); bad files fail
@@ -333,6 +338,111 @@ def mode_pareto():
         shutil.rmtree(tmp, ignore_errors=True)
 
 
+def yaml_balls(path):
+    """The balls of a design file's abu section: [(mass_kg, diameter_m), ...]."""
+    return [(float(m), float(d)) for m, d in re.findall(r"- \{mass_kg: ([0-9.e+-]+), diameter_m: ([0-9.e+-]+)\}",
+                                                         open(path).read())]
+
+
+def mode_choices():
+    tmp = tempfile.mkdtemp(prefix="abuopt_study_choices_")
+    try:
+        base = open(tiny_study(tmp)).read()
+        # 1. the ball count a variable of the global stage (DIRECT_L: 20 evaluations reach every count)
+        text = base.replace("stages:", "choices:\n  balls: {counts: [2, 3, 4], total_mass_kg: 2.8e-4, mode: variable}\nstages:")
+        text = text.replace("{algorithm: direct_l, max_evaluations: 3}", "{algorithm: direct_l, max_evaluations: 20}")
+        study = os.path.join(tmp, "variable.yaml")
+        open(study, "w").write(text)
+        p = run(["study", study, "--check"])
+        if "balls in [1.5, 4.5] (rounded to the nearest count)" not in p.stdout:
+            fail("--check of the variable count:\n" + p.stdout)
+        out = os.path.join(tmp, "v")
+        run(["study", study, "--out", out, "--threads", "1"])
+        s = json.load(open(os.path.join(out, "summary.json")))
+        if not s["ball_count_variable"] or [c["label"] for c in s["choices"]] != ["balls2", "balls3", "balls4"]:
+            fail(f"choices: {s['choices']}")
+        glob_trace = s["traces"][0]
+        if glob_trace["choice"] != "variable count" or glob_trace["balls"] != 0:
+            fail(f"the global stage's trace: {glob_trace}")
+        counted = sum(c["evaluations"] for c in s["choices"])
+        if counted != glob_trace["evaluations"] or sum(1 for c in s["choices"] if c["evaluations"] > 0) < 2:
+            fail(f"evaluations per count {[c['evaluations'] for c in s['choices']]} vs the stage's {glob_trace['evaluations']}")
+        chosen = [c for c in s["choices"] if c["chosen"]]
+        if len(chosen) != 1:
+            fail(f"chosen: {chosen}")
+        n = len(chosen[0]["balls"])
+        best = [c["best_feasible_objective"] for c in s["choices"] if c["best_feasible_objective"] is not None]
+        if chosen[0]["best_feasible_objective"] is not None and chosen[0]["best_feasible_objective"] != min(best):
+            fail("the chosen count is not the best one")
+        for d in s["designs"]:  # the global stage's best and the polish: the chosen count
+            if d["balls"] != n:
+                fail(f"design {d['label']} has {d['balls']} balls, the chosen count is {n}")
+            balls = yaml_balls(os.path.join(out, d["file"]))
+            if len(balls) != n or any(abs(m - 2.8e-4 / n) > 1e-15 for m, _ in balls):
+                fail(f"{d['file']}: balls {balls}, expected {n} of {2.8e-4 / n} kg")
+        md = open(os.path.join(out, "report.md")).read()
+        if "## Ball choices" not in md or f"they chose {n} balls" not in md:
+            fail("report.md does not say which count was chosen:\n" + md[:3000])
+        if "Ball choices" not in open(os.path.join(out, "report.html")).read():
+            fail("report.html has no ball choices")
+        run(["study", study, "--out", out, "--threads", "1"])
+        s2 = json.load(open(os.path.join(out, "summary.json")))
+        if s2["archive_hits"] != s2["evaluations"] or comparable(s2) != comparable(s):
+            fail("a rerun of the variable-count study changed the results or computed again")
+
+        # 2. two ball sets, each optimised; the abu section's ball keys
+        sets = ("choices:\n  balls:\n    sets:\n"
+                "      - {name: two_heavy, ball_count: 2, ball_mass_kg: 1.4e-4, ball_diameter_m: 3e-3}\n"
+                "      - {balls: [{mass_kg: 1e-4, diameter_m: 2.5e-3}, {mass_kg: 1e-4, diameter_m: 2.5e-3}, "
+                "{mass_kg: 8e-5, diameter_m: 2.5e-3}]}\nstages:")
+        text = base.replace("stages:", sets)
+        study = os.path.join(tmp, "sets.yaml")
+        open(study, "w").write(text)
+        out = os.path.join(tmp, "s")
+        run(["study", study, "--out", out, "--threads", "1"])
+        s = json.load(open(os.path.join(out, "summary.json")))
+        if [c["label"] for c in s["choices"]] != ["two_heavy", "set2"] or s["ball_count_variable"]:
+            fail(f"sets: {s['choices']}")
+        labels = [d["label"] for d in s["designs"]]
+        for want in ("two_heavy_global", "two_heavy_local", "set2_global", "set2_local"):
+            if want not in labels:
+                fail(f"{want} not among {labels}")
+        balls = yaml_balls(os.path.join(out, "designs", "set2_local.yaml"))
+        if balls != [(1e-4, 2.5e-3), (1e-4, 2.5e-3), (8e-5, 2.5e-3)]:
+            fail(f"set2's design file has balls {balls}")
+        if "## Ball choices" not in open(os.path.join(out, "report.md")).read():
+            fail("no ball choices in report.md")
+
+        # 3. bad choices: exit 2, the key named
+        for old, new, want in [
+                ("balls: {counts: [2, 3, 4], total_mass_kg: 2.8e-4, mode: variable}",
+                 "balls: {counts: [2, 4], total_mass_kg: 2.8e-4, mode: variable}", "choices.balls.mode = variable"),
+                ("balls: {counts: [2, 3, 4], total_mass_kg: 2.8e-4, mode: variable}",
+                 "balls: {counts: [2, 3], mode: sometimes}", "choices.balls.mode = sometimes"),
+                ("ball_diameter_m: 3e-3}", "ball_diameter_m: 0.02}", "choices.balls.sets[0].balls[0].diameter_m"),
+                ("{name: two_heavy, ball_count: 2,", "{name: two_heavy, ball_count: 2, balls: [], ",
+                 "choices.balls.sets[0].ball_count")]:
+            src = open(os.path.join(tmp, "variable.yaml" if "counts" in old else "sets.yaml")).read()
+            assert old in src, old
+            bad = os.path.join(tmp, "bad.yaml")
+            open(bad, "w").write(src.replace(old, new))
+            p = run(["study", bad, "--check"], expect=2)
+            if want not in p.stderr:
+                fail(f"bad choices ({new}): {p.stderr}")
+        src = open(os.path.join(tmp, "variable.yaml")).read()
+        i, j = src.index("  - {kind: global"), src.index("  - {kind: local")
+        bad = src[:i] + src[j:]  # no global stage: nothing would choose the count
+        open(os.path.join(tmp, "bad.yaml"), "w").write(bad)
+        p = run(["study", os.path.join(tmp, "bad.yaml"), "--check"], expect=2)
+        if "first optimiser stage must be global" not in p.stderr:
+            fail("a variable count without a global stage: " + p.stderr)
+        print(f"ok: the ball count a variable ({n} balls chosen; evaluations per count "
+              f"{[c['evaluations'] for c in json.load(open(os.path.join(tmp, 'v', 'summary.json')))['choices']]}), "
+              "two ball sets, bad choices named")
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
 def study_files():
     """Every `abuopt study` file under configs/studies/ (the `abuopt optimize` configs there have no `stages:`)."""
     out = []
@@ -391,4 +501,5 @@ def mode_check():
         shutil.rmtree(tmp, ignore_errors=True)
 
 
-{"tiny": mode_tiny, "browser": mode_browser, "quick": mode_quick, "check": mode_check, "pareto": mode_pareto}[MODE]()
+{"tiny": mode_tiny, "browser": mode_browser, "quick": mode_quick, "check": mode_check, "pareto": mode_pareto,
+ "choices": mode_choices}[MODE]()

@@ -64,6 +64,18 @@ struct RelativeConstraints {
   std::optional<double> startup_time_vs_baseline;          // T <= factor x the baseline's T
 };
 
+// One discrete choice of balls: a count at the total mass (choices.balls.counts) or a ball set
+// (choices.balls.sets).
+struct BallChoice {
+  std::string label;        // "balls3" (a count) or the set's name (default "set<i+1>")
+  std::vector<Ball> balls;
+};
+
+// "3 balls" for a count, the set's name for a set (logs, notes, the report).
+std::string choice_name(const BallChoice& c);
+// The balls' distinct diameters in mm, "3" or "2.5/3".
+std::string diameters_mm(const std::vector<Ball>& balls);
+
 struct StudyFile {
   std::string path;                  // the file as given
   std::string title;
@@ -71,8 +83,11 @@ struct StudyFile {
   std::size_t threads = 0;           // Monte Carlo workers (0: all cores); results do not depend on it
   bool frequencies_natural = false;  // family: free frequency values in units of f_n = sqrt(k/M)/2pi
   problems::ProfileDesign family;    // as written (natural units not yet applied)
-  std::vector<std::size_t> ball_counts;  // choices (one entry: the abu's balls)
-  std::optional<double> total_ball_mass_kg;
+  std::vector<BallChoice> choices;   // one entry (label "balls<n>"): the abu's balls
+  std::optional<double> total_ball_mass_kg;  // choices.balls.counts
+  // choices.balls.mode: variable (counts only): the global stages see the count as one more variable
+  // (problems::BallCountDesign, the abu's ball diameter), the later stages polish the chosen count(s)
+  bool ball_count_variable = false;
   problems::ObjectiveSettings objective;
   problems::ConstraintSettings constraints;
   RelativeConstraints relative;
@@ -83,11 +98,15 @@ struct StudyFile {
 // Reads and validates a study file. Throws ConfigError naming the key, the value and the rule.
 StudyFile read_study_file(const std::string& path);
 
-// The ABU of one choice (ball count at the total mass) and the problem settings of that choice:
+// The ABU of one choice (index into f.choices) and the problem settings of that choice:
 // family frequencies in Hz, relative constraints resolved against `baseline` metrics.
-AbuParameters abu_of_choice(const StudyFile& f, std::size_t balls);
-problems::StartupProfileSettings settings_of_choice(const StudyFile& f, std::size_t balls,
+AbuParameters abu_of_choice(const StudyFile& f, std::size_t choice);
+problems::StartupProfileSettings settings_of_choice(const StudyFile& f, std::size_t choice,
                                                     const std::map<std::string, double>& baseline_metrics);
+// choices.balls.mode: variable: the settings of the first choice with the ball count free over the
+// counts (the global stages' problem).
+problems::StartupProfileSettings settings_of_variable_count(const StudyFile& f,
+                                                            const std::map<std::string, double>& baseline_metrics);
 // Which free end frequencies can reach f_n (Hz); empty message when one can.
 std::string resonance_reach_text(const problems::ProfileDesign& d, double natural_frequency_hz);
 
@@ -95,6 +114,7 @@ std::string resonance_reach_text(const problems::ProfileDesign& d, double natura
 struct StudyPlan {
   long long runs_per_evaluation = 0;    // sampling.runs x the robust friction values (if any)
   long long optimiser_evaluations = 0;  // min(the optimiser stages' budgets x choices, budget.max_evaluations)
+  long long other_evaluations = 0;      // the baseline and the evaluations on fresh samples (Monte Carlos)
   long long simulations = 0;            // an upper estimate of the simulations of the whole study
   std::vector<std::string> warnings;    // the family cannot reach the resonance, ...
 };
@@ -106,7 +126,8 @@ std::string plan_text(const StudyFile& f);
 // One evaluated design (a point of one stage).
 struct StudyDesign {
   std::string label;          // "balls2_local" ...
-  std::size_t balls = 0;
+  std::size_t choice = 0;     // index into StudyFile::choices
+  std::size_t balls = 0;      // the ball count of that choice
   std::string stage;
   std::vector<std::string> variable_names;
   std::vector<double> x;
@@ -119,7 +140,8 @@ struct StudyDesign {
 
 struct StageTrace {
   std::string stage;
-  std::size_t balls = 0;
+  std::string choice;                  // the choice's label ("variable count" for a global stage over the count)
+  std::size_t balls = 0;               // its ball count (0: the count is a variable)
   std::string algorithm;
   std::string reason;
   long evaluations = 0, archive_hits = 0;
@@ -182,6 +204,16 @@ struct StudyResult {
   std::vector<StageTrace> traces;
   ValidationResult validation;
   ParetoFront front;
+  // How each ball choice did: with choices.balls.mode: variable, per count the global stages'
+  // evaluations there and the best feasible objective; otherwise each choice's final design.
+  struct ChoiceSummary {
+    std::string label;
+    std::size_t balls = 0;
+    long evaluations = 0;          // variable mode: the global stages' evaluations at this count
+    double best_feasible = 0;      // in sample (NaN: none feasible)
+    bool chosen = false;           // variable mode: polished by the later stages
+  };
+  std::vector<ChoiceSummary> choice_summary;
 };
 
 struct StudyRunOptions {
