@@ -11,6 +11,7 @@
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/progress.hpp"
 #include "abuopt/common/stop.hpp"
+#include "abuopt/parallel/parallel.hpp"
 #include "abuopt/studies/study.hpp"
 #include "commands/commands.hpp"
 
@@ -43,6 +44,12 @@ int run_study_command(const StudyArgs& a) {
   studies::StudyRunOptions o;
   o.out = out;
   if (a.threads) o.threads = static_cast<std::size_t>(*a.threads);
+  // under mpirun every Monte Carlo of the study is spread over the ranks (as abuopt optimize does;
+  // docs/cluster.md); the results are the same as one process's
+  if (parallel::session() && parallel::session()->size() > 1) {
+    o.runner = parallel::make_runner(a.threads ? static_cast<std::size_t>(*a.threads) : f.threads);
+    std::cout << "every Monte Carlo over " << parallel::session()->size() << " MPI ranks\n" << std::flush;
+  }
   o.log = [&](const std::string& line) { bar.message(line, stdout); };
   o.progress = [&](long done, long total) {
     bar.set_total(static_cast<std::size_t>(total));

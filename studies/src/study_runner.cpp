@@ -82,6 +82,7 @@ problems::StartupProfileSettings StudyContext::baseline_settings() const {
 
 opt::Evaluation StudyContext::evaluate_profile(const problems::StartupProfileSettings& s, const StartupProfile& p) {
   problems::StartupProfileProblem problem(s);
+  if (options.runner) problem.set_monte_carlo_runner(options.runner);
   const std::string id = problem.identity() + "/profile-" + hex16(problems::fnv1a64(write_fields(p)));
   opt::EvaluationArchive archive(archive_path, id);
   const std::vector<double> key = {0.0};
@@ -320,6 +321,7 @@ StudyResult run_study(const StudyFile& f, const StudyRunOptions& o) {
     if (o.threads) s.threads = *o.threads;
     const double fn = s.study.setup.abu.natural_frequency_hz();
     ch.problem = std::make_unique<problems::StartupProfileProblem>(s);
+    if (o.runner) ch.problem->set_monte_carlo_runner(o.runner);
     ch.archive = std::make_unique<opt::EvaluationArchive>(c.archive_path, ch.problem->identity());
     ch.archive->record_metadata("study", f.path, prov.config_hash);
     ch.archived = std::make_unique<opt::ArchivedProblem>(*ch.problem, *ch.archive);
@@ -340,6 +342,7 @@ StudyResult run_study(const StudyFile& f, const StudyRunOptions& o) {
     problems::StartupProfileSettings s = settings_of_variable_count(f, result.baseline.metrics);
     if (o.threads) s.threads = *o.threads;
     v.problem = std::make_unique<problems::StartupProfileProblem>(s);
+    if (o.runner) v.problem->set_monte_carlo_runner(o.runner);
     v.archive = std::make_unique<opt::EvaluationArchive>(c.archive_path, v.problem->identity());
     v.archive->record_metadata("study", f.path, prov.config_hash);
     v.archived = std::make_unique<opt::ArchivedProblem>(*v.problem, *v.archive);

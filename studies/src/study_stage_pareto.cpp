@@ -62,6 +62,7 @@ void run_pareto_stage(StudyContext& c, const StageSpec& stage) {
       if (c.options.threads) s.threads = *c.options.threads;
       s.constraints.max_startup_time_s = bound;
       problems::StartupProfileProblem problem(s);
+      if (c.options.runner) problem.set_monte_carlo_runner(c.options.runner);
       opt::EvaluationArchive archive(c.archive_path, problem.identity());
       opt::ArchivedProblem archived(problem, archive);
       std::vector<double> least(problem.inequality_names().size(), std::numeric_limits<double>::infinity());

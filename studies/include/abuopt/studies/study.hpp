@@ -28,10 +28,12 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "abuopt/core/batch_runner.hpp"
 #include "abuopt/core/monte_carlo.hpp"
 #include "abuopt/optimizer/optimization_result.hpp"
 #include "abuopt/optimizer/optimizer_options.hpp"
@@ -222,6 +224,9 @@ struct StudyRunOptions {
   std::function<void(const std::string&)> log;     // one line at a time
   std::function<void(long done, long total)> progress;  // evaluations of the budget
   std::function<bool()> stop_requested;            // polled between evaluations
+  // Where every Monte Carlo runs (e.g. over MPI ranks: parallel::make_runner); null: a thread pool
+  // of the file's (or `threads`) workers. Results do not depend on it.
+  std::shared_ptr<BatchRunner> runner;
 };
 
 StudyResult run_study(const StudyFile& f, const StudyRunOptions& o);
