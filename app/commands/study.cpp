@@ -84,8 +84,14 @@ int run_study_command(const StudyArgs& a) {
     std::cerr << "\n";
     return 3;
   }
-  std::cout << "recommended: " << r.designs[*r.recommended].label << " (" << out << "/designs/"
-            << r.designs[*r.recommended].label << ".yaml)\n";
+  const studies::Verdict v = studies::verdict_of(r);
+  std::cout << (v == studies::Verdict::Recommended  ? "recommended: "
+                : v == studies::Verdict::Candidate  ? "candidate (not feasible on every fresh sample): "
+                : v == studies::Verdict::Worse      ? "best design found, worse than the baseline on fresh samples: "
+                : v == studies::Verdict::NoBetter   ? "best design found, no better than the baseline on fresh samples: "
+                                                     : "best design found (in sample only): ")
+            << r.designs[*r.recommended].label << " (" << out << "/designs/" << r.designs[*r.recommended].label
+            << ".yaml)\n";
   return 0;
 }
 

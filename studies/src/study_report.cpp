@@ -67,6 +67,21 @@ std::string verdict_text(const ValidationResult& v) {
   return "No difference from the baseline that " + n + " can tell (the 95 % interval of the ratio contains 1).";
 }
 
+// Why the headline says what it says (after the headline's design).
+std::string headline_reason(Verdict v) {
+  switch (v) {
+    case Verdict::Recommended: return "feasible on every fresh sample and better than the baseline on fresh samples";
+    case Verdict::NoBetter:
+      return "no better than the baseline that the fresh samples can tell: the baseline is as good";
+    case Verdict::Worse: return "worse than the baseline on fresh samples: keep the baseline";
+    case Verdict::Candidate:
+      return "it did not meet the constraints on every fresh sample: a candidate to check, not an answer";
+    case Verdict::Unvalidated: return "in sample only (no validate stage): not checked on fresh samples";
+    case Verdict::None: return "";
+  }
+  return "";
+}
+
 std::string choices_sentence(const StudyFile& f, const StudyResult& r) {
   std::ostringstream os;
   const std::string won = r.recommended ? choice_name(f.choices[r.designs[*r.recommended].choice]) : "";
@@ -88,11 +103,45 @@ std::string choices_sentence(const StudyFile& f, const StudyResult& r) {
     if (f.total_ball_mass_kg) os << " (counts at " << sig3(*f.total_ball_mass_kg) << " kg in all)";
     os << ".";
   }
-  if (!won.empty()) os << " The recommended design has " << won << ".";
+  if (!won.empty()) os << " The best design has " << won << ".";
   return os.str();
 }
 
 }  // namespace detail
+
+Verdict verdict_of(const StudyResult& r) {
+  if (!r.recommended) return Verdict::None;
+  if (r.candidate) return Verdict::Candidate;
+  const ValidationResult& v = r.validation;
+  if (!v.done || v.ratio_mean_ir.samples < 2) return Verdict::Unvalidated;
+  if (v.ratio_mean_ir.hi < 1.0) return Verdict::Recommended;
+  if (v.ratio_mean_ir.lo > 1.0) return Verdict::Worse;
+  return Verdict::NoBetter;
+}
+
+std::string to_string(Verdict v) {
+  switch (v) {
+    case Verdict::Recommended: return "recommended";
+    case Verdict::NoBetter: return "no_better";
+    case Verdict::Worse: return "worse";
+    case Verdict::Candidate: return "candidate";
+    case Verdict::Unvalidated: return "unvalidated";
+    case Verdict::None: return "none";
+  }
+  return "none";
+}
+
+std::string headline_of(Verdict v) {
+  switch (v) {
+    case Verdict::Recommended: return "Recommended design";
+    case Verdict::Candidate: return "Candidate design";
+    case Verdict::NoBetter:
+    case Verdict::Worse:
+    case Verdict::Unvalidated: return "Best design found";
+    case Verdict::None: return "No design is recommended";
+  }
+  return "";
+}
 
 namespace {
 
@@ -158,12 +207,14 @@ std::string markdown(const StudyFile& f, const StudyResult& r) {
   md << "# Study: " << f.title << "\n\n";
   const StudyDesign* rec = r.recommended ? &r.designs[*r.recommended] : nullptr;
   md << "## Answer\n\n";
+  const Verdict verdict = verdict_of(r);
   if (!rec) {
     md << "**No design is recommended.**";
     for (const auto& n : r.notes) md << " " << n << ".";
     md << "\n\n";
   } else {
-    md << "Recommended: **" << rec->label << "** - " << rec->balls << " balls, " << drive_text(f.base.setup.motor)
+    md << headline_of(verdict) << ": **" << rec->label << "** (" << headline_reason(verdict) << ") - " << rec->balls
+       << " balls, " << drive_text(f.base.setup.motor)
        << ", profile " << profile_text(rec->profile) << ", peak angular acceleration "
        << sig3(problems::peak_angular_acceleration_rad_s2(rec->profile)) << " rad/s^2 (baseline "
        << sig3(r.baseline_peak_acceleration) << ").\n\n";
@@ -171,14 +222,14 @@ std::string markdown(const StudyFile& f, const StudyResult& r) {
     if (v.done) {
       md << "On " << v.seeds.size() << " fresh samples of " << v.runs
          << " runs over the envelope (mean and 95 % interval over the samples):\n\n"
-         << "| | recommended | baseline |\n|---|---|---|\n";
+         << "| | " << rec->label << " | baseline |\n|---|---|---|\n";
       const std::pair<const char*, const char*> rows[] = {{"ir_magnitude_mean", "mean \\|I_r\\| [1e-7 kg m]"},
                                                          {"ir_magnitude_max", "max \\|I_r\\| [1e-7 kg m]"},
                                                          {"pct_mi", "%MI"},
                                                          {"amplitude_max_mm", "peak amplitude [mm]"}};
       for (const auto& [k, label] : rows)
         md << "| " << label << " | " << interval_text(v.design.at(k)) << " | " << interval_text(v.baseline.at(k)) << " |\n";
-      md << "\nRatio of mean |I_r| (recommended / baseline): " << interval_text(v.ratio_mean_ir) << ". "
+      md << "\nRatio of mean |I_r| (" << rec->label << " / baseline): " << interval_text(v.ratio_mean_ir) << ". "
          << verdict_text(v) << "\n\n";
     }
   }
@@ -282,6 +333,7 @@ nlohmann::json summary(const StudyFile& f, const StudyResult& r) {
   }
   j["designs"] = designs;
   j["recommended"] = r.recommended ? nlohmann::json(r.designs[*r.recommended].label) : nlohmann::json(nullptr);
+  j["verdict"] = to_string(verdict_of(r));
   if (r.validation.done) {
     const ValidationResult& v = r.validation;
     nlohmann::json dv = nlohmann::json::object(), bv = nlohmann::json::object();

@@ -37,6 +37,7 @@ const char* const kStyle = R"(
 body{font-family:sans-serif;max-width:1100px;margin:1em auto;padding:0 1em;color:#222}
 h1{font-size:1.5em} h2{font-size:1.2em;margin-top:1.6em;border-bottom:1px solid #ccc}
 .answer{border:2px solid #2a7;background:#f3fbf6;padding:0.8em 1.2em;border-radius:6px}
+.answer.caution{border-color:#d80;background:#fff8ec}
 .warn{border:2px solid #d80;background:#fff8ec;padding:0.6em 1.2em;border-radius:6px}
 table{border-collapse:collapse;margin:0.6em 0;font-size:0.9em} td,th{border:1px solid #bbb;padding:3px 7px;text-align:left}
 th{background:#eee} td.num{text-align:right;font-variant-numeric:tabular-nums}
@@ -62,7 +63,7 @@ std::string choices_html(const StudyFile& f, const StudyResult& r) {
     double mass = 0;
     for (const Ball& b : f.choices[i].balls) mass += b.mass_kg;
     const bool won = r.recommended && r.designs[*r.recommended].choice == i;
-    h << "<tr" << (won ? " style=\"font-weight:bold\"" : "") << "><td>" << esc(cs.label) << (won ? " (recommended)" : "")
+    h << "<tr" << (won ? " style=\"font-weight:bold\"" : "") << "><td>" << esc(cs.label) << (won ? " (the best design)" : "")
       << "</td><td class=\"num\">" << cs.balls << "</td><td class=\"num\">" << sig3(mass)
       << "</td><td class=\"num\">" << diameters_mm(f.choices[i].balls) << "</td><td class=\"num\">" << cs.evaluations
       << "</td><td class=\"num\">" << (std::isfinite(cs.best_feasible) ? sig3(cs.best_feasible) : "none feasible")
@@ -162,16 +163,20 @@ std::string study_html(const StudyFile& f, const StudyResult& r) {
   const StudyDesign* rec = r.recommended ? &r.designs[*r.recommended] : nullptr;
 
   // ---- the answer ----
+  const Verdict verdict = verdict_of(r);
   if (rec) {
-    h << "<div class=\"answer\"><p><b>Recommended design: " << esc(rec->label) << "</b> &mdash; " << rec->balls
-      << " balls, " << esc(drive_text(f.base.setup.motor)) << ".</p><p>Profile: " << esc(profile_text(rec->profile))
+    // green only for a design to build; amber for one to check or to drop
+    h << "<div class=\"" << (verdict == Verdict::Recommended ? "answer" : "answer caution") << "\"><p><b>"
+      << esc(headline_of(verdict)) << ": " << esc(rec->label) << "</b> &mdash; " << esc(headline_reason(verdict))
+      << ".</p><p>" << rec->balls
+ << " balls, " << esc(drive_text(f.base.setup.motor)) << ".<br>Profile: " << esc(profile_text(rec->profile))
       << "<br>Peak angular acceleration " << sig3(problems::peak_angular_acceleration_rad_s2(rec->profile))
       << " rad/s&sup2; (baseline " << sig3(r.baseline_peak_acceleration) << ").</p>\n";
     const ValidationResult& v = r.validation;
     if (v.done) {
       h << "<p>On " << v.seeds.size() << " fresh samples of " << v.runs
         << " runs over the envelope (mean and 95&nbsp;% interval over the samples):</p>\n"
-        << "<table><tr><th></th><th>recommended</th><th>baseline</th></tr>\n";
+        << "<table><tr><th></th><th>" << esc(rec->label) << "</th><th>baseline</th></tr>\n";
       const std::pair<const char*, const char*> rows[] = {{"ir_magnitude_mean", "mean |I<sub>r</sub>| [10<sup>-7</sup> kg m]"},
                                                          {"ir_magnitude_max", "max |I<sub>r</sub>| [10<sup>-7</sup> kg m]"},
                                                          {"pct_mi", "%MI"},
@@ -180,7 +185,7 @@ std::string study_html(const StudyFile& f, const StudyResult& r) {
         h << "<tr><td>" << label << "</td><td class=\"num\">" << interval_text(v.design.at(k))
           << "</td><td class=\"num\">" << interval_text(v.baseline.at(k)) << "</td></tr>\n";
       h << "<tr><td><b>ratio of mean |I<sub>r</sub>|</b></td><td class=\"num\" colspan=\"2\"><b>"
-        << interval_text(v.ratio_mean_ir) << "</b> (recommended / baseline)</td></tr></table>\n<p><b>"
+        << interval_text(v.ratio_mean_ir) << "</b> (" << esc(rec->label) << " / baseline)</td></tr></table>\n<p><b>"
         << esc(verdict_text(v)) << "</b></p>\n";
     } else {
       h << "<p>In sample: objective " << sig3(rec->in_sample.objective) << " against the baseline's "
@@ -190,6 +195,8 @@ std::string study_html(const StudyFile& f, const StudyResult& r) {
   } else {
     h << "<div class=\"warn\"><p><b>No design is recommended.</b></p></div>\n";
   }
+  // the figures name the headline's design as the headline does
+  const std::string who = verdict == Verdict::Recommended ? "recommended" : verdict == Verdict::Candidate ? "candidate" : "best";
   if (!r.notes.empty() || r.interrupted) {
     h << "<div class=\"warn\"><ul>";
     if (r.interrupted) h << "<li>The study was interrupted: rerun the same command to resume from the archive.</li>";
@@ -224,17 +231,17 @@ std::string study_html(const StudyFile& f, const StudyResult& r) {
     ++colour;  // palette(1) is the recommended design's red
   }
   if (r.recommended)
-    prof.push_back(speed_series(r.designs[*r.recommended].profile, r.designs[*r.recommended].label + " (recommended)",
+    prof.push_back(speed_series(r.designs[*r.recommended].profile, r.designs[*r.recommended].label + " (" + who + ")",
                                 "#d62728", 3.0, false));
   h << "<h2>Profiles</h2>\n<figure>" << svg_line_chart("Disc speed against time", "time [s]", "speed [Hz]", prof, 900, 420)
-    << "<figcaption>The recommended design (thick red), the baseline (dashed grey) and every stage's best design. "
+    << "<figcaption>The " << who << " design (thick red), the baseline (dashed grey) and every stage's best design. "
     << "Natural frequency of the ABU as given: " << sig3(f.base.setup.abu.natural_frequency_hz()) << " Hz.</figcaption></figure>\n";
 
   // ---- the envelope map ----
   if (!r.validation.map_ratio.empty()) {
     const ValidationResult& v = r.validation;
     h << "<h2>Ratio to the baseline over the envelope</h2>\n<figure>"
-      << svg_heatmap("mean |I_r| of the recommended design / the baseline's", "friction mu",
+      << svg_heatmap("mean |I_r| of the " + who + " design / the baseline's", "friction mu",
                      "imbalance mass factor", v.map_mu, v.map_imbalance, v.map_ratio, 1.0, 720,
                      std::max(220, 80 + 50 * static_cast<int>(v.map_imbalance.size())))
       << "<figcaption>Each cell: a Monte Carlo of " << v.map_runs
@@ -247,7 +254,7 @@ std::string study_html(const StudyFile& f, const StudyResult& r) {
     const ValidationResult& v = r.validation;
     std::vector<SvgPointGroup> groups = {
         {"baseline (" + std::to_string(v.final_baseline.size()) + " runs)", "#555555", v.final_baseline, true},
-        {"recommended (" + std::to_string(v.final_design.size()) + " runs)", "#d62728", v.final_design, false}};
+        {who + " design (" + std::to_string(v.final_design.size()) + " runs)", "#d62728", v.final_design, false}};
     h << "<h2>Final ball positions over the equilibrium set</h2>\n<figure>"
       << svg_points_over_set("Final angles of the two balls", "beta_1 [deg]", "beta_2 [deg]", v.eq_n, v.eq_in_set,
                              "equilibrium set (" + sig3(v.eq_frequency_hz) + " Hz, mu " + sig3(v.eq_mu) + ")",
@@ -286,10 +293,20 @@ std::string study_html(const StudyFile& f, const StudyResult& r) {
     conv.push_back(all);
     conv.push_back(best);
   }
+  if (offset > 0 && std::isfinite(r.baseline.objective)) {  // the level to beat
+    SvgSeries level;
+    level.name = "baseline, in sample";
+    level.color = "#444444";
+    level.width = 1.5;
+    level.dashed = true;
+    level.x = {1.0, offset};
+    level.y = {r.baseline.objective, r.baseline.objective};
+    conv.push_back(level);
+  }
   h << "<figure>" << svg_line_chart("Objective of every evaluation, stages one after another", "evaluation",
                                     "objective (" + to_string(f.objective.kind) + ")", conv, 900, 460)
-    << "<figcaption>Stages run in order; each optimiser stage starts from the previous best. The baseline's objective "
-       "in sample is "
+    << "<figcaption>Stages run in order; each optimiser stage starts from the previous best. Dashed grey: the "
+       "baseline's objective in sample, "
     << sig3(r.baseline.objective) << ".</figcaption></figure>\n<table><tr><th>stage</th><th>choice</th><th>algorithm</th>"
        "<th>reason</th><th>evaluations</th><th>from archive</th></tr>\n";
   for (const auto& t : r.traces)

@@ -43,6 +43,7 @@ void run_replicate_stage(StudyContext& c, const StageSpec& stage) {
   }
   if (!c.result.recommended) {
     recommend_in_sample(c);
+    c.result.candidate = c.result.recommended.has_value();
     c.result.notes.push_back(
         c.result.recommended
             ? "no design met the constraints on every fresh sample; the recommendation is the best in-sample design, "

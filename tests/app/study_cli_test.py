@@ -103,8 +103,21 @@ def check_outputs(out, summary):
         fail("report.html refers to the network")
     if html.count("<svg") < 2:
         fail(f"report.html has {html.count('<svg')} figures")
-    if summary["recommended"] is not None and "Recommended design" not in html.split("<h2>")[0]:
-        fail("the answer is not the first thing in report.html")
+    # the headline says what the study can say: "Recommended" only for a design that held up on fresh
+    # samples and beat the baseline there; the answer comes first
+    headline = {"recommended": "Recommended design", "candidate": "Candidate design", "no_better": "Best design found",
+                "worse": "Best design found", "unvalidated": "Best design found", "none": "No design is recommended"}
+    first = html.split("<h2>")[0]
+    if headline[summary["verdict"]] not in first:
+        fail(f"verdict {summary['verdict']}: the headline is not the first thing in report.html")
+    if summary["verdict"] != "recommended" and "Recommended design" in html:
+        fail(f"verdict {summary['verdict']} but the report says 'Recommended design'")
+    ratio = summary.get("validation", {}).get("ratio_mean_abs_ir")
+    if summary["verdict"] == "recommended" and not (ratio and ratio["hi95"] < 1):
+        fail("recommended without a validation better than the baseline")
+    md = open(os.path.join(out, "report.md")).read()
+    if headline[summary["verdict"]] not in md.split("## ")[1]:
+        fail("report.md's answer and report.html's disagree")
 
 
 def mode_tiny():
@@ -202,7 +215,8 @@ def mode_browser():
         console = [l for l in p.stderr.splitlines() if ":CONSOLE" in l]
         if console:
             fail("console messages:\n" + "\n".join(console))
-        if "Recommended design" not in p.stdout and "No design is recommended" not in p.stdout:
+        if not any(h in p.stdout for h in ("Recommended design", "Candidate design", "Best design found",
+                                           "No design is recommended")):
             fail("Chromium's DOM lacks the answer:\n" + p.stdout[:2000])
         # 2. a copy with a check script: every figure laid out with a non-zero size
         checked = os.path.join(out, "report_check.html")

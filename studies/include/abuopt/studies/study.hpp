@@ -202,7 +202,8 @@ struct StudyResult {
   std::vector<std::string> constraint_names;
   std::vector<std::string> notes;              // resonance reach, unmet constraints, ...
   std::vector<StudyDesign> designs;            // every stage's best, per choice
-  std::optional<std::size_t> recommended;      // index into designs
+  std::optional<std::size_t> recommended;      // index into designs (the best design found; see verdict)
+  bool candidate = false;  // a replicate stage ran and no design met the constraints on every fresh sample
   std::vector<StageTrace> traces;
   ValidationResult validation;
   ParetoFront front;
@@ -230,6 +231,17 @@ struct StudyRunOptions {
 };
 
 StudyResult run_study(const StudyFile& f, const StudyRunOptions& o);
+
+// What the study can say of its best design, for the headline of every report and the command's
+// last line: recommended (feasible on every fresh sample and, validated, better than the baseline
+// on fresh samples), no_better (validated: no difference the samples can tell), worse (validated:
+// worse than the baseline), candidate (not feasible on every fresh sample), unvalidated (no
+// validate stage), none (no design).
+enum class Verdict { Recommended, NoBetter, Worse, Candidate, Unvalidated, None };
+Verdict verdict_of(const StudyResult& r);
+std::string to_string(Verdict v);  // recommended, no_better, worse, candidate, unvalidated, none
+// The headline's first words: "Recommended design", "Candidate design", "Best design found", ...
+std::string headline_of(Verdict v);
 
 // report.html, report.md, summary.json and designs/<label>.yaml (ready for `abuopt montecarlo`).
 // Returns the files written.
