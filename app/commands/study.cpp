@@ -71,7 +71,7 @@ int run_study_command(const StudyArgs& a) {
   }
   bar.finish();
   const auto files = studies::write_study_report(f, r, out);
-  std::cout << "wrote " << out << "/report.html, report.md, summary.json and " << r.designs.size()
+  std::cout << "wrote " << out << "/report.html, report.md, summary.json and " << r.designs.size() + r.front.points.size()
             << " designs in " << out << "/designs/ (" << r.wall_time_s << " s)\n";
   if (r.interrupted) {
     std::cerr << "abuopt: interrupted by " << stop_signal_name() << ": the partial report is written and every finished "
