@@ -8,7 +8,8 @@
 // The file says everything: the ABU (`abu`, `motor`, `simulation`), the envelope of uncertain
 // parameters (`envelope`), the initial-angle sampling (`sampling`), the `baseline` profile, the
 // profile `family` (free values with bounds, frequencies optionally in units of the ABU's natural
-// frequency), discrete `choices` (ball count at a total ball mass), the `objective` and
+// frequency), discrete `choices` (ball counts at a total ball mass, enumerated or as one more
+// variable of the global stages, or ball sets), the `objective` and
 // `constraints` (absolute, or relative to the baseline), the `stages` and one `budget`.
 // Stage kinds (one file each, studies/src/study_stage_*.cpp):
 //   global     an optimiser of the registry from the family's starting point
