@@ -155,6 +155,13 @@ TEST(SweepCli, GridSweepWritesEveryPointResumesAndExportsTheSameBits) {
     EXPECT_EQ(a.at(i, "objective_hw95"), a.at(i, "ir_magnitude_mean_hw95"));
   }
   const nlohmann::json s = read_json(out / "summary.json");
+  // depth_mean = mean |I_r| / r_lock; r_lock = 2 bbar sqrt(1 - bbar^2) M L mu / (1 + mu) = 15.90e-7 kg m
+  // at mu 0.02 (docs/equilibrium_sets.md section 4).
+  ASSERT_TRUE(s["r_lock_kgm"].is_number());
+  const double r_lock = s["r_lock_kgm"].get<double>();
+  EXPECT_NEAR(r_lock / 1e-7, 15.90, 0.005);
+  for (std::size_t i = 0; i < 6; ++i)
+    EXPECT_NEAR(parse(a.at(i, "depth_mean")), parse(a.at(i, "ir_magnitude_mean")) * 1e-7 / r_lock, 1e-12) << i;
   expect_provenance(s, cfg);
   EXPECT_EQ(s["points_evaluated"], 6);
   EXPECT_EQ(s["computed"], 6);
