@@ -269,3 +269,41 @@ TEST(FinalStates, EarlyLateSplitOfHandMadeRuns) {
   bad[1].beta_final.pop_back();
   EXPECT_THROW(abuopt::analyse_final_states(p, prof, bad), abuopt::ConfigError);
 }
+
+// Near a balancing point uniform starts are uniform in the U plane (docs/equilibrium_sets.md section 6):
+// dU/dbeta has the columns i m L e^{i beta_k}, singular values sqrt(2) m L (cos(s/2), sin(s/2)) at separation
+// s; at the balancing separation s* = 1.7435 rad 1.083 and 0.910 m L (ratio 1.190), checked by central
+// differences; and the share of the torus with |U| <= 0.15 m L is r^2 / (2 pi (m L)^2 sin s*) = 0.00364.
+TEST(FinalStates, UniformStartsNearTheBalancingPoints) {
+  const AbuParameters p = with_mu(0.02);
+  const double mL = 1.4e-4 * p.ball_track_radius_m;
+  const double s = 2 * std::acos(p.imbalance_kgm() / (2 * mL));
+  EXPECT_NEAR(s, 1.7435, 5e-5);
+  const std::vector<double> b{M_PI - s / 2, M_PI + s / 2};
+  EXPECT_LT(std::abs(abuopt::residual_complex_kgm(p, b)), 1e-12 * p.imbalance_kgm());
+  const double h = 1e-6;
+  std::complex<double> c[2];
+  for (int k = 0; k < 2; ++k) {
+    auto up = b, dn = b;
+    up[k] += h;
+    dn[k] -= h;
+    c[k] = (abuopt::residual_complex_kgm(p, up) - abuopt::residual_complex_kgm(p, dn)) / (2 * h);
+  }
+  const double fro2 = std::norm(c[0]) + std::norm(c[1]);
+  const double det = std::abs(c[0].real() * c[1].imag() - c[1].real() * c[0].imag());
+  const double hi = std::sqrt((fro2 + std::sqrt(fro2 * fro2 - 4 * det * det)) / 2), lo = det / hi;
+  EXPECT_NEAR(hi / mL, std::sqrt(2.0) * std::sin(s / 2), 1e-7);
+  EXPECT_NEAR(lo / mL, std::sqrt(2.0) * std::abs(std::cos(s / 2)), 1e-7);
+  EXPECT_NEAR(hi / mL, 1.083, 5e-4);
+  EXPECT_NEAR(lo / mL, 0.910, 5e-4);
+  EXPECT_NEAR(hi / lo, 1.190, 1e-3);
+  const double r = 0.15 * mL;
+  const int g = 1200;
+  long hits = 0;
+  for (int i = 0; i < g; ++i)
+    for (int j = 0; j < g; ++j)
+      hits += std::abs(abuopt::residual_complex_kgm(p, {2 * M_PI * (i + 0.5) / g, 2 * M_PI * (j + 0.5) / g})) <= r;
+  const double expect = r * r / (2 * M_PI * mL * mL * std::sin(s));
+  EXPECT_NEAR(expect, 0.00364, 5e-6);
+  EXPECT_NEAR(static_cast<double>(hits) / (g * g), expect, 0.05 * expect);
+}
