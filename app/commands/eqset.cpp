@@ -45,6 +45,8 @@ struct EqsetArgs {
   std::string out;
   bool json = false;
   EqsetRunsArgs runs;  // --runs RUNS_CSV (commands/eqset_runs.hpp)
+  bool lock_set = false;
+  std::optional<double> alpha;
 };
 
 // The optional `eqset` section of the config; command-line options override it.
@@ -435,6 +437,20 @@ int run_eqset(const EqsetArgs& a) {
   const SimulationSetup setup = read_simulation_setup(root);
   const EqsetConfig cfg = read_eqset_section(root.child("eqset"));
   finish_config(root);  // a montecarlo (or any other known) section is not used here
+  if (a.alpha && !(std::isfinite(*a.alpha) && *a.alpha >= 0))
+    throw ConfigError("--alpha", num_text(*a.alpha), "must be an angular acceleration >= 0 in rad/s^2");
+  if (a.lock_set) {
+    const std::size_t nb = setup.abu.balls.size();
+    if (nb < 2) throw ConfigError("abu.balls", std::to_string(nb) + " balls", "the lock-set grid needs at least 2 balls");
+    if (cfg.other_angles_rad.size() != nb - 2)
+      throw ConfigError("eqset.other_angles_rad", std::to_string(cfg.other_angles_rad.size()) + " angles",
+                        "must give the fixed angles of balls 3.." + std::to_string(nb) + " (" + std::to_string(nb - 2) +
+                            " values)");
+    AbuParameters abu = setup.abu;
+    if (a.mu) abu.friction_mu = *a.mu;
+    return run_eqset_lock_set(abu, cfg.other_angles_rad, static_cast<std::size_t>(a.grid ? *a.grid : 160),
+                              a.alpha.value_or(0.0), a.json);
+  }
   if (!a.runs.runs_csv.empty()) {
     EqsetRunsArgs r = a.runs;
     r.out = a.out;
@@ -481,6 +497,8 @@ void register_eqset(CLI::App& app) {
       "  --runs RUNS_CSV: where the runs of `abuopt montecarlo CONFIG --out DIR` (DIR/runs.csv) stopped against\n"
       "    the sets: settling speed, gauge, depth |U|/r_lock, the runs locked early (before the band) and late;\n"
       "    with --out DIR also DIR/final_states.csv (one line per settled run).\n"
+      "  --lock-set: the share of uniform starts in the lock set (a grid, --grid, default 160), their depth and\n"
+      "    lock gauge; with --alpha the share out of a ramp's reach (docs/equilibrium_sets.md section 6).\n"
       "Exit status: 0 ok, 2 bad input, 3 no settled run (--runs).");
   sub->add_option("config", args->config, "YAML config (section abu; optional section eqset)")->required();
   auto* freq = sub->add_option("--freq", args->freq, "constant speed in Hz (> 0)");
@@ -489,6 +507,13 @@ void register_eqset(CLI::App& app) {
   auto* runs = sub->add_option("--runs", args->runs.runs_csv, "runs.csv of `abuopt montecarlo --out DIR`: final states against the sets");
   runs->excludes(freq);
   runs->excludes(scan);
+  auto* lock = sub->add_flag("--lock-set", args->lock_set,
+                             "uniform starts in the lock set (in the set of every speed): share, depth, lock gauge");
+  lock->excludes(freq);
+  lock->excludes(scan);
+  lock->excludes(runs);
+  sub->add_option("--alpha", args->alpha, "--lock-set: the peak angular acceleration of a ramp in rad/s^2 (its reach)")
+      ->needs(lock);
   sub->add_option("--split", args->runs.split, "--runs: early runs by settling speed (speed, default) or before the first passage of the band edge (passage)")->needs(runs);
   sub->add_option("--edge", args->runs.edge_hz, "--runs: the band edge of the split in Hz (default: the speed below resonance where r_in = 2 r_lock)")->needs(runs);
   sub->add_option("--grid", args->grid, "points per axis of the (beta_1, beta_2) grid, >= 2 (default 128; scan 64)");

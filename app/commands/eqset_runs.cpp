@@ -224,4 +224,41 @@ int run_eqset_runs(const SimulationSetup& setup, const EqsetRunsArgs& a) {
   return r.settled ? 0 : 3;
 }
 
+int run_eqset_lock_set(const AbuParameters& abu, const std::vector<double>& other_beta, std::size_t grid,
+                       double alpha_rad_s2, bool json) {
+  const LockSetStatistics st = lock_set_statistics(abu, grid, other_beta, alpha_rad_s2);
+  const double rl = lock_radius_kgm(abu);
+  const auto band = lock_band_hz(abu);
+  if (json) {
+    nlohmann::json j;
+    j["mu"] = abu.friction_mu;
+    j["r_lock_kgm"] = rl;
+    j["lock_band_hz"] = {band.first, band.second};
+    j["grid"] = grid;
+    j["share"] = st.share;
+    j["depth_mean"] = num_json(st.depth_mean);
+    j["lock_gauge_mean"] = num_json(st.lock_gauge_mean);
+    j["floor"] = num_json(st.share * st.depth_mean);
+    j["alpha_rad_s2"] = alpha_rad_s2;
+    j["reach"] = st.reach;
+    j["unreached_share"] = st.unreached_share;
+    j["unreached_depth_mean"] = num_json(st.unreached_depth_mean);
+    std::cout << j.dump(2) << "\n";
+    return 0;
+  }
+  std::cout << "mu " << format_number(abu.friction_mu) << ": r_lock " << fixed(rl / 1e-7, 2)
+            << "e-7 kg m; lock set = in the set of every speed of " << fixed(band.first, 2) << " .. "
+            << fixed(band.second, 2) << " Hz\n"
+            << "  uniform starts (" << grid << " x " << grid << " grid over beta_1, beta_2) in the lock set: "
+            << fixed(100 * st.share, 1) << " %, mean depth |U|/r_lock " << fixed(st.depth_mean, 3)
+            << ", mean lock gauge " << fixed(st.lock_gauge_mean, 3) << "; share x depth " << fixed(st.share * st.depth_mean, 3)
+            << " r_lock\n";
+  if (alpha_rad_s2 > 0)
+    std::cout << "  a ramp at " << format_number(alpha_rad_s2) << " rad/s^2 uses " << fixed(st.reach, 3)
+              << " of the friction at resonance; locked starts with lock gauge <= " << fixed(1 - st.reach, 3) << ": "
+              << fixed(100 * st.unreached_share, 1) << " %, mean depth " << fixed(st.unreached_depth_mean, 3)
+              << "; share x depth " << fixed(st.unreached_share * st.unreached_depth_mean, 3) << " r_lock\n";
+  return 0;
+}
+
 }  // namespace abuopt::app

@@ -3,6 +3,7 @@
 // equilibrium sets (core/final_states.hpp; docs/equilibrium_sets.md section 6).
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "abuopt/core/simulator.hpp"
 
@@ -20,5 +21,10 @@ struct EqsetRunsArgs {
 // ABU and profile of `setup` and the run's own mu / imbalance mass / stiffness, prints the
 // distribution. Returns the exit status (0; 3 when no run settled). ConfigError on bad input.
 int run_eqset_runs(const SimulationSetup& setup, const EqsetRunsArgs& a);
+
+// abuopt eqset CONFIG --lock-set [--grid N] [--alpha RAD_S2] [--mu MU]: uniform starts in the lock set
+// (core lock_set_statistics) over the n x n grid of the first two balls, the others at other_beta.
+int run_eqset_lock_set(const AbuParameters& abu, const std::vector<double>& other_beta, std::size_t grid,
+                       double alpha_rad_s2, bool json);
 
 }  // namespace abuopt::app

@@ -230,6 +230,43 @@ double cluster_floor_kgm(const AbuParameters& p, const std::vector<double>& beta
   return std::max(0.0, 2 * longest - std::accumulate(a.begin(), a.end(), 0.0));
 }
 
+LockSetStatistics lock_set_statistics(const AbuParameters& p, std::size_t n, const std::vector<double>& other_beta,
+                                      double alpha_rad_s2) {
+  if (p.balls.size() < 2 || other_beta.size() != p.balls.size() - 2 || n == 0)
+    throw std::invalid_argument("lock_set_statistics: needs >= 2 balls, the angles of balls 3..N and n > 0");
+  LockSetStatistics out;
+  out.grid = n;
+  const double omega_n = 2 * M_PI * p.natural_frequency_hz();
+  out.reach = alpha_rad_s2 > 0 ? alpha_rad_s2 / (p.friction_mu * omega_n * omega_n) : 0.0;
+  const double rl = lock_radius_kgm(p);
+  std::vector<double> beta(p.balls.size());
+  std::copy(other_beta.begin(), other_beta.end(), beta.begin() + 2);
+  std::size_t locked = 0, unreached = 0;
+  double depth = 0, gauge = 0, depth_unreached = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < n; ++j) {
+      beta[0] = kTwoPi * (static_cast<double>(i) + 0.5) / static_cast<double>(n);
+      beta[1] = kTwoPi * (static_cast<double>(j) + 0.5) / static_cast<double>(n);
+      const double g = lock_gauge(p, beta);
+      if (!(g <= 1)) continue;
+      const double d = std::abs(residual_complex_kgm(p, beta)) / rl;
+      ++locked;
+      depth += d;
+      gauge += g;
+      if (g <= 1 - out.reach) {
+        ++unreached;
+        depth_unreached += d;
+      }
+    }
+  const double total = static_cast<double>(n) * static_cast<double>(n);
+  out.share = static_cast<double>(locked) / total;
+  out.depth_mean = locked ? depth / static_cast<double>(locked) : kNaN;
+  out.lock_gauge_mean = locked ? gauge / static_cast<double>(locked) : kNaN;
+  out.unreached_share = static_cast<double>(unreached) / total;
+  out.unreached_depth_mean = unreached ? depth_unreached / static_cast<double>(unreached) : kNaN;
+  return out;
+}
+
 std::optional<double> first_passage_s(const StartupProfile& profile, double level_hz) {
   double f0 = profile.start_frequency_hz();
   if (f0 >= level_hz) return 0.0;

@@ -157,3 +157,27 @@ TEST(EqsetRunsCli, SixBallsAtTheRunsMu) {
   for (const auto& row : rows)
     EXPECT_NEAR(std::stod(row.at("depth")) * std::stod(row.at("r_lock_kgm")), ir.at(row.at("index")), 1e-6 * 5.6e-4 * 3.7e-3);
 }
+
+// --lock-set: uniform starts in the lock set of configs/eqset.yaml at mu 0.03 on a 40 x 40 grid, 49.9 %
+// (FinalStates.LockSetOfUniformStarts), and the reach of a ramp at 314.16 rad/s^2, 0.318.
+TEST(EqsetRunsCli, LockSetOfUniformStarts) {
+  const std::string cfg = src("configs/eqset.yaml");
+  const auto r = abuopt::test::run_abuopt("eqset " + cfg + " --lock-set --grid 40 --mu 0.03 --alpha 314.16 --json", "", false);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  EXPECT_EQ(j["grid"].get<int>(), 40);
+  EXPECT_NEAR(j["share"].get<double>(), 0.499, 0.006);
+  EXPECT_NEAR(j["reach"].get<double>(), 0.318, 5e-4);
+  EXPECT_LT(j["unreached_share"].get<double>(), j["share"].get<double>());
+  EXPECT_NEAR(j["floor"].get<double>(), j["share"].get<double>() * j["depth_mean"].get<double>(), 1e-15);
+  EXPECT_NEAR(j["r_lock_kgm"].get<double>() / 1e-7, 23.62, 0.005);
+  const auto text = abuopt::test::run_abuopt("eqset " + cfg + " --lock-set --grid 40", "", false);
+  ASSERT_EQ(text.status, 0) << text.output;
+  EXPECT_NE(text.output.find("in the lock set: "), std::string::npos) << text.output;
+  const auto bad = abuopt::test::run_abuopt("eqset " + cfg + " --lock-set --alpha -1");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.output.find("--alpha = -1: must be an angular acceleration >= 0"), std::string::npos) << bad.output;
+  const auto both = abuopt::test::run_abuopt("eqset " + cfg + " --lock-set --freq 29");
+  EXPECT_EQ(both.status, 2) << both.output;
+}
+

@@ -154,6 +154,31 @@ TEST(FinalStates, LockSetOfUniformStarts) {
   EXPECT_NEAR(static_cast<double>(locked) / (n * n), 0.499, 0.006);
   EXPECT_NEAR(static_cast<double>(disc) / (n * n), 0.425, 0.006);
   EXPECT_NEAR(gsum / locked, 0.653, 0.03);
+  const auto st = abuopt::lock_set_statistics(p, n);
+  EXPECT_EQ(st.share, static_cast<double>(locked) / (n * n));
+  EXPECT_NEAR(st.lock_gauge_mean, gsum / locked, 1e-12);
+  EXPECT_EQ(st.reach, 0.0);
+  EXPECT_EQ(st.unreached_share, st.share);
+}
+
+// The Euler term of a ramp at alpha = 314.16 rad/s^2 (the 2003 profile's peak) uses u = alpha / (mu omega_n^2)
+// of the friction at resonance: 314.16 / (0.03 (2 pi 28.8853)^2) = 0.318 at mu 0.03, 0.477 at mu 0.02. On an
+// 80 x 80 grid at mu 0.03 the lock set is 50.1 % of the torus at a mean depth of 0.739 r_lock, and the locked
+// starts out of that reach (g_lock <= 1 - u) 24.8 % at 0.536 r_lock (the 160 x 160 figures of
+// docs/equilibrium_sets.md section 6, within 0.01; the retired Python script's 26 .. 40 Hz band gave 50.2 %,
+// 0.739, 24.9 %, 0.537).
+TEST(FinalStates, LockSetOutOfTheRampsReach) {
+  const AbuParameters p = with_mu(0.03);
+  const auto st = abuopt::lock_set_statistics(p, 80, {}, 314.16);
+  EXPECT_NEAR(st.reach, 0.318, 5e-4);
+  EXPECT_NEAR(abuopt::lock_set_statistics(with_mu(0.02), 2, {}, 314.16).reach, 0.477, 5e-4);
+  EXPECT_NEAR(st.share, 0.501, 0.01);
+  EXPECT_NEAR(st.depth_mean, 0.739, 0.01);
+  EXPECT_NEAR(st.lock_gauge_mean, 0.654, 0.01);
+  EXPECT_NEAR(st.unreached_share, 0.248, 0.01);
+  EXPECT_NEAR(st.unreached_depth_mean, 0.536, 0.01);
+  EXPECT_LT(st.unreached_depth_mean, st.depth_mean);
+  EXPECT_THROW(abuopt::lock_set_statistics(six_balls(), 8), std::invalid_argument);  // balls 3..6 need angles
 }
 
 // Two touching balls: s_c = 2 asin(d / 2L) = 0.2616 rad, floor |m_I e - 2 m L cos(s_c / 2)| = 11.20e-7;

@@ -123,6 +123,19 @@ FinalStateAnalysis analyse_final_states(const AbuParameters& nominal, const Star
                                         const std::vector<FinalStateInput>& runs, EarlySplit split = EarlySplit::speed,
                                         std::optional<double> edge_hz = std::nullopt);
 
+// Uniform starts in the lock set: the n x n grid beta_k = 2 pi (k + 1/2) / n over the first two balls (the
+// others at other_beta; contact is not considered), the share of its points with g_lock <= 1, their mean
+// depth and mean lock gauge. A ramp at the angular acceleration alpha [rad/s^2] reaches the locked
+// configurations with g_lock > 1 - u, u = alpha / (mu omega_n^2) (its Euler term, docs/equilibrium_sets.md
+// section 6): the share and mean depth of those with g_lock <= 1 - u ("unreached"; u = 0 without alpha).
+struct LockSetStatistics {
+  std::size_t grid = 0;
+  double share = 0, depth_mean = 0, lock_gauge_mean = 0;
+  double reach = 0, unreached_share = 0, unreached_depth_mean = 0;
+};
+LockSetStatistics lock_set_statistics(const AbuParameters& p, std::size_t n, const std::vector<double>& other_beta = {},
+                                      double alpha_rad_s2 = 0);
+
 // The first time [s] the profile reaches level_hz from below; nullopt if it never does.
 std::optional<double> first_passage_s(const StartupProfile& profile, double level_hz);
 
