@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "abuopt_cli.hpp"
+#include "startup_problem_yaml.hpp"
 
 #include <cstdint>
 #include <cstdio>
@@ -99,29 +100,9 @@ void expect_provenance(const nlohmann::json& j, const std::string& config) {
   EXPECT_EQ(j["provenance"]["config_hash"], fnv_of_file(config));
 }
 
-const char* kBase = R"(abu:
-  friction_mu: 0.02
-profile:
-  start_frequency_hz: 0
-  segments:
-    - {end_frequency_hz: 25.0, duration_s: 1.0}
-    - {end_frequency_hz: 29.5, duration_s: 10.0}
-    - {end_frequency_hz: 100.0, duration_s: 8.0}
-simulation:
-  method: event_driven
-montecarlo:
-  design: lhs
-  runs: 8
-  seed: 7
-design:
-  segments:
-    - end_frequency_hz: {min: 15, max: 28, x0: 25}
-      duration_s: {min: 0.3, max: 3, x0: 1}
-    - end_frequency_hz: {min: 28, max: 32, x0: 29.5}
-      duration_s: {min: 1, max: 12, x0: 10}
-    - end_frequency_hz: 100
-      duration_s: {min: 1, max: 10, x0: 8}
-objective:
+const std::string kBase =
+    abuopt_test::kReportAbuAndProfile + "simulation:\n  method: event_driven\n" + abuopt_test::lhs_montecarlo(8) +
+    abuopt_test::kThreeSegmentDesign + R"(objective:
   kind: mean
 validation:
   runs: 16
