@@ -181,3 +181,45 @@ TEST(EqsetRunsCli, LockSetOfUniformStarts) {
   EXPECT_EQ(both.status, 2) << both.output;
 }
 
+// The runs locked before the band are uniform starts in the lock set (docs/equilibrium_sets.md section 6):
+// a two-ball design whose first ramp stops at 22.6 Hz, at mu 0.03, 256 random starts: its early runs are as
+// many as the lock set's share of the torus (50.1 %, `--lock-set`) within 3 binomial sigma (9.4 points)
+// and as deep (0.739 r_lock) within 0.08 (3 standard errors of about 130 runs); they settle in the first
+// ramp (p90 below 23 Hz), the late ones in the band (p10 above 28 Hz).
+TEST(EqsetRunsCli, EarlyRunsAreUniformStartsInTheLockSet) {
+  const fs::path dir = fresh_dir("eqset_runs_cli_test_lock");
+  const fs::path cfg = dir / "k4.yaml";
+  std::ofstream(cfg) << R"(abu:
+  friction_mu: 0.03
+  ball_contact: hard
+profile:
+  start_frequency_hz: 0.0
+  segments:
+    - {end_frequency_hz: 22.6222, duration_s: 1.55852}
+    - {end_frequency_hz: 28.9129, duration_s: 3.4931}
+    - {end_frequency_hz: 28.9129, duration_s: 3.71217}
+    - {end_frequency_hz: 100, duration_s: 5.08554}
+motor:
+  kind: ideal
+simulation:
+  method: event_driven
+  rtol: 1.0e-6
+)";
+  auto mc = abuopt::test::run_abuopt("montecarlo " + cfg.string() + " --design random --runs 256 --seed 9001 --threads 1 --out " +
+                                     (dir / "mc").string(), "", false);
+  ASSERT_EQ(mc.status, 0) << mc.output;
+  const auto r = abuopt::test::run_abuopt("eqset " + cfg.string() + " --runs " + (dir / "mc" / "runs.csv").string() + " --json",
+                                          "", false);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  const auto lock = nlohmann::json::parse(
+      abuopt::test::run_abuopt("eqset " + cfg.string() + " --lock-set --grid 80 --json", "", false).output);
+  const double p = lock["share"].get<double>(), n = j["settled"].get<double>();
+  EXPECT_NEAR(p, 0.501, 0.01);
+  EXPECT_GT(n, 250);
+  EXPECT_NEAR(j["early"]["share"].get<double>(), p, 3 * std::sqrt(p * (1 - p) / n));
+  EXPECT_NEAR(j["early"]["depth_mean"].get<double>(), lock["depth_mean"].get<double>(), 0.08);
+  EXPECT_LT(j["early"]["settle_hz"]["p90"].get<double>(), 23.0);
+  EXPECT_GT(j["late"]["settle_hz"]["p10"].get<double>(), 28.0);
+}
+
