@@ -432,6 +432,10 @@ int run_eqset(const EqsetArgs& a) {
 
   if (!a.runs.runs_csv.empty() && a.mu)
     throw ConfigError("--mu", num_text(*a.mu), "cannot be given with --runs (the runs.csv gives each run's mu)");
+  if (!a.runs.runs_csv.empty() && a.grid)
+    throw ConfigError("--grid", std::to_string(*a.grid), "has no use with --runs (no grid: the runs' own angles)");
+  if (a.lock_set && !a.out.empty())
+    throw ConfigError("--out", a.out, "has no use with --lock-set (it prints its figures; --json for one object)");
 
   YamlReader root = YamlReader::load_file(a.config);
   const SimulationSetup setup = read_simulation_setup(root);

@@ -39,17 +39,15 @@ std::pair<double, double> gain_peak(const AbuParameters& p) {
 
 // The speed [Hz] on the falling (below = true: rising) side of |G| where |G| = target, by bisection.
 double gain_level_hz(const AbuParameters& p, double target, bool below) {
-  const double fn = p.natural_frequency_hz();
-  const auto [w_peak, g_peak] = gain_peak(p);
+  const double w_peak = gain_peak(p).first;
   if (!std::isfinite(w_peak)) return below ? 0.0 : kInf;
-  const double f_peak = w_peak * fn;
-  double lo = below ? 0.0 : f_peak, hi = below ? f_peak : f_peak;
+  const double f_peak = w_peak * p.natural_frequency_hz();
+  double lo = below ? 0.0 : f_peak, hi = f_peak;
   if (!below) {
     hi = 2 * f_peak;
     while (std::abs(steady_gain(p, hi)) > target && hi < 1e12) hi *= 2;
     if (std::abs(steady_gain(p, hi)) > target) return kInf;  // |G| stays above target (heavy damping)
   }
-  (void)g_peak;
   for (int k = 0; k < 200 && hi - lo > 1e-12 * hi; ++k) {
     const double mid = 0.5 * (lo + hi);
     const bool above_target = std::abs(steady_gain(p, mid)) > target;

@@ -129,6 +129,9 @@ TEST(EqsetRunsCli, TwoBallsOfThe2003Profile) {
   const auto mu = abuopt::test::run_abuopt("eqset " + cfg + " --runs " + runs + " --mu 0.03");
   EXPECT_EQ(mu.status, 2);
   EXPECT_NE(mu.output.find("--mu"), std::string::npos) << mu.output;
+  const auto grid = abuopt::test::run_abuopt("eqset " + cfg + " --runs " + runs + " --grid 20");
+  EXPECT_EQ(grid.status, 2);
+  EXPECT_NE(grid.output.find("--grid = 20: has no use with --runs"), std::string::npos) << grid.output;
   const auto missing = abuopt::test::run_abuopt("eqset " + cfg + " --runs " + (dir / "none.csv").string());
   EXPECT_EQ(missing.status, 2);
   EXPECT_NE(missing.output.find("cannot be read"), std::string::npos) << missing.output;
@@ -179,6 +182,9 @@ TEST(EqsetRunsCli, LockSetOfUniformStarts) {
   EXPECT_NE(bad.output.find("--alpha = -1: must be an angular acceleration >= 0"), std::string::npos) << bad.output;
   const auto both = abuopt::test::run_abuopt("eqset " + cfg + " --lock-set --freq 29");
   EXPECT_EQ(both.status, 2) << both.output;
+  const auto out = abuopt::test::run_abuopt("eqset " + cfg + " --lock-set --out /tmp/never");
+  EXPECT_EQ(out.status, 2);
+  EXPECT_NE(out.output.find("--out = /tmp/never: has no use with --lock-set"), std::string::npos) << out.output;
 }
 
 // The runs locked before the band are uniform starts in the lock set (docs/equilibrium_sets.md section 6):
