@@ -434,6 +434,8 @@ int run_eqset(const EqsetArgs& a) {
     throw ConfigError("--mu", num_text(*a.mu), "cannot be given with --runs (the runs.csv gives each run's mu)");
   if (!a.runs.runs_csv.empty() && a.grid)
     throw ConfigError("--grid", std::to_string(*a.grid), "has no use with --runs (no grid: the runs' own angles)");
+  if (a.lock_set && a.grid && *a.grid > 1024)  // ~80 us per point (281 speeds): 1024^2 points take about 90 s
+    throw ConfigError("--grid", std::to_string(*a.grid), "must be at most 1024 with --lock-set (points per axis)");
   if (a.lock_set && !a.out.empty())
     throw ConfigError("--out", a.out, "has no use with --lock-set (it prints its figures; --json for one object)");
 
