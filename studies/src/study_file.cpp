@@ -224,7 +224,9 @@ AbuParameters abu_of_choice(const StudyFile& f, std::size_t balls) {
   AbuParameters p = f.base.setup.abu;
   if (!f.total_ball_mass_kg) return p;
   Ball b = p.balls.front();
-  b.mass_kg = *f.total_ball_mass_kg / static_cast<double>(balls);
+  const double m = *f.total_ball_mass_kg / static_cast<double>(balls);
+  b.diameter_m *= std::cbrt(m / b.mass_kg);  // the first ball's material (density): the diameter follows the mass
+  b.mass_kg = m;
   p.balls.assign(balls, b);
   return p;
 }
