@@ -197,7 +197,9 @@ StudyFile read_study_file(const std::string& path) {
           for (const BallChoice& other : f.choices)
             if (other.balls.size() == n)
               throw ConfigError(b.key_path("counts"), format_number(v), "each count may appear once");
-          Ball ball = setup.abu.balls.front();  // the abu's diameter
+          Ball ball = setup.abu.balls.front();
+          // the first ball's material (density): the diameter follows the mass
+          ball.diameter_m *= std::cbrt((total / v) / ball.mass_kg);
           ball.mass_kg = total / v;
           f.choices.push_back({"balls" + std::to_string(n), std::vector<Ball>(n, ball)});
         }
@@ -352,7 +354,9 @@ problems::StartupProfileSettings settings_of_variable_count(const StudyFile& f,
   }
   b.value = static_cast<double>(f.choices.front().balls.size());  // the first count listed
   b.total_mass_kg = f.total_ball_mass_kg.value_or(0.0);
-  b.diameter_m = f.base.setup.abu.balls.front().diameter_m;  // as the enumerated counts
+  const Ball& first = f.base.setup.abu.balls.front();  // as the enumerated counts: the first ball's density
+  b.diameter_m.reset();
+  b.density_kg_m3 = first.mass_kg / (M_PI / 6.0 * first.diameter_m * first.diameter_m * first.diameter_m);
   return s;
 }
 

@@ -103,6 +103,17 @@ TEST(StudyFile, BallCountsAtATotalMass) {
   const AbuParameters three = abu_of_choice(f, 1);
   ASSERT_EQ(three.balls.size(), 3u);
   EXPECT_NEAR(three.balls[0].mass_kg, 1.4e-4, 1e-18);
+  EXPECT_NEAR(three.balls[0].diameter_m, 3e-3, 1e-15);  // the first ball's mass: its diameter
+}
+
+TEST(StudyFile, BallDiameterFollowsTheMassAtTheFirstBallsDensity) {
+  const std::string text =
+      replace(quick_text(), "objective: {kind: mean}", "choices: {balls: {counts: [2, 6], total_mass_kg: 2.8e-4}}\nobjective: {kind: mean}");
+  const AbuParameters six = abu_of_choice(read_text(text), 6);
+  ASSERT_EQ(six.balls.size(), 6u);
+  EXPECT_NEAR(six.balls[0].mass_kg, 2.8e-4 / 6, 1e-18);
+  // steel balls of 1.4e-4 kg are 3 mm across: a third of the mass is 3 mm x 3^(-1/3) = 2.0801 mm
+  EXPECT_NEAR(six.balls[5].diameter_m, 2.0801e-3, 1e-7);
 }
 
 TEST(StudyFile, ResonanceOutOfReachIsSaid) {
