@@ -109,7 +109,7 @@ TEST(StudyFile, BallCountsAtATotalMass) {
 TEST(StudyFile, BallDiameterFollowsTheMassAtTheFirstBallsDensity) {
   const std::string text =
       replace(quick_text(), "objective: {kind: mean}", "choices: {balls: {counts: [2, 6], total_mass_kg: 2.8e-4}}\nobjective: {kind: mean}");
-  const AbuParameters six = abu_of_choice(read_text(text), 6);
+  const AbuParameters six = abu_of_choice(read_text(text), 1);  // the second choice: 6 balls
   ASSERT_EQ(six.balls.size(), 6u);
   EXPECT_NEAR(six.balls[0].mass_kg, 2.8e-4 / 6, 1e-18);
   // steel balls of 1.4e-4 kg are 3 mm across: a third of the mass is 3 mm x 3^(-1/3) = 2.0801 mm
@@ -218,7 +218,9 @@ TEST(StudyFile, BallSetsAndTheVariableCount) {
   EXPECT_EQ(s.design.ball_count.lower, 2);
   EXPECT_EQ(s.design.ball_count.upper, 4);
   EXPECT_EQ(s.design.ball_count.value, 3);  // the first count listed
-  EXPECT_EQ(*s.design.ball_count.diameter_m, 3e-3);  // the abu's, as the enumerated counts
+  // the first ball's density, as the enumerated counts: 1.4e-4 kg in a 3 mm sphere
+  EXPECT_FALSE(s.design.ball_count.diameter_m.has_value());
+  EXPECT_NEAR(s.design.ball_count.density_kg_m3, 1.4e-4 / (M_PI / 6.0 * 27e-9), 1e-6);
   const problems::StartupProfileProblem p(s);
   EXPECT_EQ(p.variables().back().name, "balls");
   // the variable's ABU at each count is the enumerated choice's
