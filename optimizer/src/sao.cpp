@@ -82,6 +82,28 @@ void SaoRun::run(const std::vector<double>& x0) {
   double streak_radius = radius_;  // the radius before the first of them
   bool polished = false;  // the current trust region has handed over to the polish
   while (true) {
+    // the best objective's gains of the last window are within the noise: the trust region has
+    // converged as far as the noise lets one tell, and after a restart the run (docs/sao.md,
+    // "Stop when the rest is noise")
+    const NoiseStall stall = noise_stall();
+    if (stall != NoiseStall::None) {
+      reason = TerminationReason::ConvergedFtol;
+      message = "the best objective improved by less than " + format_number(sao_.noise_stop) +
+                " noise levels (" + format_number(noise_f_) + ") in " + std::to_string(noise_window()) +
+                " evaluations" + (stall == NoiseStall::Stop ? " after a restart" : "");
+      if (stall == NoiseStall::Stop || !restart_wanted()) return;
+      const long before = driver_.evaluations();
+      const std::optional<bool> restarted = restart();
+      if (!restarted || !*restarted) return;
+      ++restarts_;
+      last_restart_evaluations_ = before;
+      polished = false;
+      message += "; restart " + std::to_string(restarts_);
+      stalled = 0;
+      failures_in_a_row = 0;
+      streak_radius = radius_;
+      continue;
+    }
     if (!polished && (radius_ < kPolishRadius || stalled >= sao_.stall_iterations) && polish_wanted()) {
       if (!polish()) return;
       polished = true;
@@ -104,9 +126,11 @@ void SaoRun::run(const std::vector<double>& x0) {
       // converged with budget left: infill points and a new trust region (docs/sao.md, "Global
       // phase", restarts); the result is the best point of the whole run (the driver's)
       if (!restart_wanted()) return;
+      const long before = driver_.evaluations();
       const std::optional<bool> restarted = restart();
       if (!restarted || !*restarted) return;
       ++restarts_;
+      last_restart_evaluations_ = before;
       polished = false;
       message += "; restart " + std::to_string(restarts_);
       stalled = 0;
@@ -155,6 +179,7 @@ void SaoRun::run(const std::vector<double>& x0) {
         sampling_ && probed_samples_ > 0 ? std::sqrt(double(probed_samples_) / double(samples_)) : 1.0;
     for (std::size_t k = 0; k < probed_noise_.size() && k < models->noise.size(); ++k)
       models->noise[k] = std::max(models->noise[k], probe_scale * probed_noise_[k]);
+    if (!models->noise.empty() && models->noise[0] > 0) noise_f_ = models->noise[0];
     bool phase1 = false;
     const Eigen::VectorXd s = solve_subproblem(*models, phase1);
     feasibility_phase_ = phase1;

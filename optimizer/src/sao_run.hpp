@@ -227,6 +227,14 @@ class SaoRun {
   // second differences of the responses say the merit's noise is comparable to the predicted reduction; nullopt once
   // the run is stopped.
   std::optional<bool> probe_noise(double predicted, bool phase1);
+  // The stop on noise (sao_noise_probe.cpp, docs/sao.md "Stop when the rest is noise"): records
+  // the best feasible objective at the current evaluation count. Restart: it has improved by less
+  // than noise_stop * noise_f_ for noise_stop_window evaluations and no restart has been tried
+  // since (the trust region is treated as converged); Stop: the same, and a restart tried since
+  // has had the window too. None while the objective's noise is unknown.
+  enum class NoiseStall { None, Restart, Stop };
+  NoiseStall noise_stall();
+  long noise_window() const { return sao_.noise_stop_window > 0 ? sao_.noise_stop_window : 10L * (n_ + 1); }
 
   const OptimizerOptions& options_;
   const SaoOptions& sao_;
@@ -255,6 +263,11 @@ class SaoRun {
   double last_probe_radius_ = kInf;
   std::vector<double> probed_noise_;  // per response, set when the probe finds noise
   std::size_t probed_samples_ = 0;    // the sample size the probe's noise was measured at
+  // the objective's noise level of the latest fit that knew it (confirmed or probed; 0: unknown)
+  double noise_f_ = 0;
+  // (evaluations, best feasible objective) at the start of every trust-region iteration
+  std::vector<std::pair<long, double>> best_trace_;
+  long last_restart_evaluations_ = -1;  // the evaluation count when the latest restart began
 
   // adaptive sample size (off: samples_ stays the problem's own size and nothing is shifted)
   bool sampling_ = false;
