@@ -88,7 +88,8 @@ std::optional<bool> SaoRun::probe_noise(double predicted, bool phase1) {
 // many. A first stall ends the trust region (a restart follows when the global phase allows one:
 // measured, a trust region stuck on a noisy constraint found the optimum after a restart); a
 // stall that a restart begun after e0 has shared for W evaluations ends the run. The trace starts
-// after the global phase: its evaluations are not a trust region's progress.
+// after the global phase: its evaluations are not a trust region's progress. Only on a stochastic
+// problem (Problem::stochastic()) or once the probe has found noise.
 SaoRun::NoiseStall SaoRun::noise_stall() {
   if (!(sao_.noise_stop > 0)) return NoiseStall::None;
   const double tol = options_.constraint_tolerance;
@@ -102,7 +103,10 @@ SaoRun::NoiseStall SaoRun::noise_stall() {
   }
   const long now = driver_.evaluations();
   best_trace_.emplace_back(now, best);
-  if (!(noise_f_ > 0) || !std::isfinite(best)) return NoiseStall::None;
+  // only where noise is known to exist: a stochastic problem, or one whose noise the probe found
+  // (on a smooth problem a residual that does not shrink with the region can be lack of fit:
+  // measured on hs071, a "noise" of 0.63 ended a run at 17.87)
+  if (!(stochastic_ || noisy_) || !(noise_f_ > 0) || !std::isfinite(best)) return NoiseStall::None;
   const double band = sao_.noise_stop * noise_f_;
   long since = now;  // e0: the first record within the band of the best
   for (const auto& [evaluations, value] : best_trace_)

@@ -107,7 +107,7 @@ class SaoRun {
  public:
   SaoRun(Problem& problem, const OptimizerOptions& options, const SaoOptions& sao, EvaluationDriver& driver)
       : options_(options), sao_(sao), driver_(driver), variables_(problem.variables()),
-        global_(sao.global_phase.enabled(problem.stochastic())) {
+        global_(sao.global_phase.enabled(problem.stochastic())), stochastic_(problem.stochastic()) {
     n_ = static_cast<int>(variables_.size());
     m_ineq_ = driver.n_inequality();
     m_eq_ = driver.n_equality();
@@ -241,6 +241,7 @@ class SaoRun {
   EvaluationDriver& driver_;
   std::vector<Variable> variables_;
   bool global_ = false;  // the global phase runs (SaoGlobalPhase::enabled for this problem)
+  bool stochastic_ = false;  // Problem::stochastic(): the stop on noise may act without a probe
   int infill_calls_ = 0;
   int restarts_ = 0;      // trust regions restarted after convergence  // global_infill calls so far (each its own random stream)
   int n_ = 0;
