@@ -73,8 +73,12 @@ void SaoRun::run(const std::vector<double>& x0) {
   if (!c0) return;
   centre_ = *c0;
   centre_z_ = known_[centre_].z;
-  mu_ = sao_.penalty_initial > 0 ? sao_.penalty_initial
-                                 : 10.0 * std::max(1.0, known_[centre_].ok ? std::fabs(known_[centre_].f) : 1.0);
+  // automatic: 10 max(1, |f(x0)|) on a stochastic problem (as measured on the startup problem);
+  // on a deterministic one 1e-3 max(1, |f(x0)|), and the multiplier estimates raise it
+  // (update_penalty): a large mu rejected the steps along hs071's curved equality (the Maratos
+  // effect) and the trust region crept at radii ~1e-3 (docs/sao.md, "Options", penalty_initial)
+  const double f0_scale = std::max(1.0, known_[centre_].ok ? std::fabs(known_[centre_].f) : 1.0);
+  mu_ = sao_.penalty_initial > 0 ? sao_.penalty_initial : (stochastic_ ? 10.0 : 1e-3) * f0_scale;
   if (global_ && !global_phase()) return;
 
   int stalled = 0;

@@ -181,7 +181,8 @@ struct SaoOptions {
   // The window of that test in evaluations; 0: automatic, 10 (n + 1).
   int noise_stop_window = 0;
 
-  // Initial exact-penalty weight mu; 0: automatic, 10 max(1, |f(x0)|).
+  // Initial exact-penalty weight mu; 0: automatic, 10 max(1, |f(x0)|) on a stochastic problem,
+  // 1e-3 max(1, |f(x0)|) on a deterministic one (the multiplier estimates raise it).
   double penalty_initial = 0.0;
   // mu >= penalty_multiplier_factor * max |lambda| (estimated multipliers); >= 1.
   double penalty_multiplier_factor = 2.0;
