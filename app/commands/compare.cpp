@@ -94,7 +94,7 @@ opt::ProblemSpec read_startup_profile_problem(YamlReader& r) {
   if (settings.validation.enabled) {
     auto validator = std::make_shared<const problems::StartupProfileProblem>(settings);
     spec.validate = [validator](const std::vector<double>& x) {
-      return validator->evaluate_out_of_sample(validator->profile_at(x));
+      return validator->evaluate_out_of_sample_at(x);  // the profile and, with design.ball_count, the balls at x
     };
   }
   read_run_settings(r, spec);

@@ -215,6 +215,7 @@ void write_best_profile(const fs::path& path, const StartupProfileProblem& probl
                         const std::string& config) {
   SimulationSetup setup = problem.settings().study.setup;
   setup.profile = problem.profile_at(r.x);
+  setup.abu = problem.abu_at(r.x);  // with design.ball_count: the balls at x
   AtomicFile f(path);
   f << "# Best startup profile of `abuopt optimize " << config << "` (" << r.algorithm << ", "
     << r.evaluations << " evaluations, " << to_string(r.reason) << ").\n"

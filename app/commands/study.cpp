@@ -11,6 +11,7 @@
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/progress.hpp"
 #include "abuopt/common/stop.hpp"
+#include "abuopt/parallel/parallel.hpp"
 #include "abuopt/studies/study.hpp"
 #include "commands/commands.hpp"
 
@@ -22,15 +23,20 @@ struct StudyArgs {
   std::string file, out;
   std::optional<long> threads;
   bool progress = false;
+  bool check = false;
 };
 
 int run_study_command(const StudyArgs& a) {
   const studies::StudyFile f = studies::read_study_file(a.file);
   if (a.threads && *a.threads < 0)
     throw ConfigError("--threads", std::to_string(*a.threads), "must be >= 0 (0 = all cores)");
+  if (a.check) {  // the file read and validated as a run reads it; the plan, nothing simulated
+    std::cout << studies::plan_text(f) << std::flush;
+    return 0;
+  }
   const std::string out = a.out.empty() ? "results/" + std::filesystem::path(a.file).stem().string() : a.out;
   const OutputDirLock lock(out);
-  std::cout << "study " << a.file << " (" << f.title << "): " << f.ball_counts.size() << " choice(s), "
+  std::cout << "study " << a.file << " (" << f.title << "): " << f.choices.size() << " choice(s), "
             << f.stages.size() << " stages, budget " << f.max_evaluations << " evaluations, " << f.base.runs
             << " runs per evaluation; output " << out << "\n"
             << std::flush;
@@ -38,6 +44,12 @@ int run_study_command(const StudyArgs& a) {
   studies::StudyRunOptions o;
   o.out = out;
   if (a.threads) o.threads = static_cast<std::size_t>(*a.threads);
+  // under mpirun every Monte Carlo of the study is spread over the ranks (as abuopt optimize does;
+  // docs/cluster.md); the results are the same as one process's
+  if (parallel::session() && parallel::session()->size() > 1) {
+    o.runner = parallel::make_runner(a.threads ? static_cast<std::size_t>(*a.threads) : f.threads);
+    std::cout << "every Monte Carlo over " << parallel::session()->size() << " MPI ranks\n" << std::flush;
+  }
   o.log = [&](const std::string& line) { bar.message(line, stdout); };
   o.progress = [&](long done, long total) {
     bar.set_total(static_cast<std::size_t>(total));
@@ -59,7 +71,7 @@ int run_study_command(const StudyArgs& a) {
   }
   bar.finish();
   const auto files = studies::write_study_report(f, r, out);
-  std::cout << "wrote " << out << "/report.html, report.md, summary.json and " << r.designs.size()
+  std::cout << "wrote " << out << "/report.html, report.md, summary.json and " << r.designs.size() + r.front.points.size()
             << " designs in " << out << "/designs/ (" << r.wall_time_s << " s)\n";
   if (r.interrupted) {
     std::cerr << "abuopt: interrupted by " << stop_signal_name() << ": the partial report is written and every finished "
@@ -72,8 +84,14 @@ int run_study_command(const StudyArgs& a) {
     std::cerr << "\n";
     return 3;
   }
-  std::cout << "recommended: " << r.designs[*r.recommended].label << " (" << out << "/designs/"
-            << r.designs[*r.recommended].label << ".yaml)\n";
+  const studies::Verdict v = studies::verdict_of(r);
+  std::cout << (v == studies::Verdict::Recommended  ? "recommended: "
+                : v == studies::Verdict::Candidate  ? "candidate (not feasible on every fresh sample): "
+                : v == studies::Verdict::Worse      ? "best design found, worse than the baseline on fresh samples: "
+                : v == studies::Verdict::NoBetter   ? "best design found, no better than the baseline on fresh samples: "
+                                                     : "best design found (in sample only): ")
+            << r.designs[*r.recommended].label << " (" << out << "/designs/" << r.designs[*r.recommended].label
+            << ".yaml)\n";
   return 0;
 }
 
@@ -92,6 +110,10 @@ void register_study(CLI::App& app) {
   sub->add_option("study", args->file, "study file (YAML)")->required();
   sub->add_option("--out", args->out, "output directory (default results/<study file stem>)");
   sub->add_option("--threads", args->threads, "Monte Carlo worker threads (0 = all cores; results do not depend on it)");
+  sub->add_flag("--check", args->check,
+                "read and validate the file as a run would (exit 2 on bad input), print the plan (f_n, free\n"
+                "variables with bounds in Hz, choices, stages, budget, estimated simulations) and exit 0\n"
+                "without simulating anything");
   sub->add_flag("--progress", args->progress, "show evaluations done, rate and ETA also when stderr is not a terminal");
   sub->callback([args] { set_exit_code(run_study_command(*args)); });
 }

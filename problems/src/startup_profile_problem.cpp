@@ -63,6 +63,17 @@ StartupProfileProblem::StartupProfileProblem(StartupProfileSettings settings) : 
       slots_.push_back({i, which == 1});
     }
   }
+  const BallCountDesign& bc = settings_.design.ball_count;
+  if (bc.free) {
+    opt::Variable var;
+    var.name = "balls";
+    var.lower = bc.lower - 0.5;
+    var.upper = bc.upper + 0.5;
+    var.scale = var.upper - var.lower;
+    ball_variable_ = variables_.size();
+    variables_.push_back(var);
+    x0_.push_back(bc.value);
+  }
   const ConstraintSettings& c = settings_.constraints;
   if (c.max_startup_time_s) constraint_names_.push_back("startup_time");
   if (c.max_amplitude_mm) constraint_names_.push_back("amplitude");
@@ -102,6 +113,33 @@ StartupProfile StartupProfileProblem::profile_at(const std::vector<double>& x) c
   return StartupProfile(std::move(segs), settings_.design.start_frequency_hz);
 }
 
+std::size_t ball_count_at(const BallCountDesign& b, double x) {
+  const double n = std::isfinite(x) ? std::round(x) : b.lower;
+  return static_cast<std::size_t>(std::clamp(n, b.lower, b.upper));
+}
+
+AbuParameters abu_with_ball_count(const AbuParameters& abu, std::size_t n, const BallCountDesign& b) {
+  AbuParameters p = abu;
+  Ball ball;
+  ball.mass_kg = b.total_mass_kg / static_cast<double>(n);
+  ball.diameter_m = b.diameter_m ? *b.diameter_m : std::cbrt(6.0 * ball.mass_kg / (M_PI * b.density_kg_m3));
+  p.balls.assign(n, ball);
+  return p;
+}
+
+std::size_t StartupProfileProblem::balls_at(const std::vector<double>& x) const {
+  if (!ball_variable_) return settings_.study.setup.abu.balls.size();
+  if (x.size() != variables_.size())
+    throw std::invalid_argument("startup profile problem: the problem has " + std::to_string(variables_.size()) +
+                                " variables, the design vector has " + std::to_string(x.size()));
+  return ball_count_at(settings_.design.ball_count, x[*ball_variable_]);
+}
+
+AbuParameters StartupProfileProblem::abu_at(const std::vector<double>& x) const {
+  if (!ball_variable_) return settings_.study.setup.abu;
+  return abu_with_ball_count(settings_.study.setup.abu, balls_at(x), settings_.design.ball_count);
+}
+
 double StartupProfileProblem::startup_time_s(const std::vector<double>& x) const {
   const StartupProfile p = profile_at(x);
   double t = 0;
@@ -113,7 +151,21 @@ opt::Evaluation StartupProfileProblem::evaluate(const std::vector<double>& x) {
   if (x.size() != variables_.size())
     return opt::Evaluation::failed("the problem has " + std::to_string(variables_.size()) +
                                    " variables, the design vector has " + std::to_string(x.size()));
-  return evaluate_profile(profile_at(x));
+  const StartupProfile p = profile_at(x);
+  if (!ball_variable_) return evaluate_profile(p);
+  return evaluate_with_threads(p, settings_.study.design, settings_.study.runs, settings_.study.seed, settings_.threads,
+                               balls_at(x));
+}
+
+opt::Evaluation StartupProfileProblem::evaluate_out_of_sample_at(const std::vector<double>& x) const {
+  const ValidationSettings& v = settings_.validation;
+  InitialConditionDesign d = settings_.study.design;
+  d.kind = v.design;
+  d.grid_points_per_axis = v.grid;
+  d.count = v.runs;
+  d.seed = v.seed;
+  return evaluate_with_threads(profile_at(x), d, v.runs, v.seed, settings_.threads,
+                               ball_variable_ ? balls_at(x) : 0);
 }
 
 opt::Evaluation StartupProfileProblem::evaluate_shared(const std::vector<double>& x, std::size_t concurrent) {
@@ -121,7 +173,7 @@ opt::Evaluation StartupProfileProblem::evaluate_shared(const std::vector<double>
   const std::size_t all = settings_.threads == 0 ? hardware_threads() : settings_.threads;
   const std::size_t share = std::max<std::size_t>(1, all / concurrent);
   return evaluate_with_threads(profile_at(x), settings_.study.design, settings_.study.runs, settings_.study.seed,
-                               share);
+                               share, ball_variable_ ? balls_at(x) : 0);
 }
 
 std::size_t StartupProfileProblem::max_sample_size() const {
@@ -149,7 +201,8 @@ opt::Evaluation StartupProfileProblem::evaluate_sampled(const std::vector<double
   const std::size_t all = settings_.threads == 0 ? hardware_threads() : settings_.threads;
   const std::size_t threads =
       concurrent > 1 ? std::max<std::size_t>(1, all / concurrent) : settings_.threads;
-  return evaluate_with_threads(profile_at(x), settings_.study.design, n, settings_.study.seed, threads);
+  return evaluate_with_threads(profile_at(x), settings_.study.design, n, settings_.study.seed, threads,
+                               ball_variable_ ? balls_at(x) : 0);
 }
 
 opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& profile) const {
@@ -174,7 +227,8 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
 
 opt::Evaluation StartupProfileProblem::evaluate_with_threads(const StartupProfile& profile,
                                                             const InitialConditionDesign& design, std::size_t runs,
-                                                            std::uint64_t seed, std::size_t threads) const {
+                                                            std::uint64_t seed, std::size_t threads,
+                                                            std::size_t balls) const {
   // Guard: a profile whose durations are not > 0 (or values not finite) is never simulated.
   const auto& segs = profile.segments();
   for (std::size_t i = 0; i < segs.size(); ++i) {
@@ -216,6 +270,7 @@ opt::Evaluation StartupProfileProblem::evaluate_with_threads(const StartupProfil
   MonteCarloStudy st = settings_.study;
   st.setup.profile = profile;
   st.design = design;
+  if (balls > 0) st.setup.abu = abu_with_ball_count(st.setup.abu, balls, settings_.design.ball_count);
   st.runs = runs;
   st.seed = seed;
   std::vector<std::optional<double>> passes;
@@ -297,6 +352,7 @@ opt::Evaluation StartupProfileProblem::evaluate_with_threads(const StartupProfil
     m["smoothing_bandwidth"] = smooth.bandwidth;
   }
   m["peak_angular_acceleration_rad_s2"] = peak_angular_acceleration_rad_s2(profile);
+  if (balls > 0) m["balls"] = static_cast<double>(balls);
   if (passes.size() > 1 || passes.front()) {
     for (std::size_t k = 0; k < passes.size(); ++k) {
       const std::string tag = std::to_string(k + 1);

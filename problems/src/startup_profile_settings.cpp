@@ -128,6 +128,22 @@ void describe_design_fields(FieldArchive& a, ProfileDesign& d, const StartupProf
          },
          FieldOptions::required_key("(one entry per profile segment: {end_frequency_hz, duration_s})"));
   if (a.reading() && d.segments.empty()) throw ConfigError(a.path("segments"), "[]", "must have at least one segment");
+  // The ball count as a variable (written, and in the identity, only when given: other problems keep their ids).
+  FieldOptions balls;
+  balls.enabled = a.reading() || d.ball_count.free;
+  BallCountDesign& b = d.ball_count;
+  a.section("ball_count", [&] {
+    if (a.reading()) b.free = true;
+    a.field("min", b.lower, Rule::in_range(1, kMaxBallCount), FieldOptions::required_key().without_identity());
+    a.field("max", b.upper, Rule::in_range(1, kMaxBallCount), FieldOptions::required_key().without_identity());
+    if (a.reading() && !a.has("x0")) b.value = b.lower;
+    a.field("x0", b.value, Rule::any(), FieldOptions::not_identity());
+    a.field("total_mass_kg", b.total_mass_kg, Rule::positive_at_most(AbuLimits::kMassKg), FieldOptions::required_key());
+    a.field("density_kg_m3", b.density_kg_m3, Rule::positive_at_most(1e5),
+            FieldOptions::only_if(!a.reading() || !a.has("diameter_m") || !a.has("density_kg_m3"),
+                                  "cannot be combined with design.ball_count.diameter_m (the diameter is given)"));
+    a.field("diameter_m", b.diameter_m, Rule::positive_at_most(AbuLimits::kLengthM));
+  }, balls);
 }
 
 void describe_fields(FieldArchive& a, ObjectiveSettings& o) {
@@ -252,6 +268,36 @@ void validate(const StartupProfileSettings& s) {
   if (free == 0)
     throw ConfigError("design.segments", std::to_string(d.segments.size()) + " segments, all values fixed",
                       "no free variable: give at least one value as {min: ..., max: ...}");
+  if (d.ball_count.free) {
+    const BallCountDesign& b = d.ball_count;
+    const auto whole = [](double v, const char* key) {
+      if (v != std::floor(v)) throw ConfigError(std::string("design.ball_count.") + key, format_number(v), "must be a whole number of balls");
+    };
+    whole(b.lower, "min");
+    whole(b.upper, "max");
+    whole(b.value, "x0");
+    if (!(b.lower < b.upper))
+      throw ConfigError("design.ball_count.min", format_number(b.lower),
+                        "must be below design.ball_count.max = " + format_number(b.upper) + " (one count: give abu.balls)");
+    if (!(b.value >= b.lower && b.value <= b.upper))
+      throw ConfigError("design.ball_count.x0", format_number(b.value),
+                        "must be in [" + format_number(b.lower) + ", " + format_number(b.upper) + "] (the bounds)");
+    if (s.study.design.kind == InitialConditionKind::Grid)
+      throw ConfigError("montecarlo.design", "grid",
+                        "cannot be used with design.ball_count (a grid's runs = grid^balls change with the count); use "
+                        "lhs, random, halton or sobol");
+    // every count must make a valid ABU (balls that fit on the track, a valid Monte Carlo)
+    for (double n : {b.lower, b.upper}) {
+      MonteCarloStudy st = s.study;
+      st.setup.abu = abu_with_ball_count(st.setup.abu, static_cast<std::size_t>(n), b);
+      try {
+        validate(st.setup.abu);
+        validate(st);
+      } catch (const ConfigError& e) {
+        throw ConfigError(std::string("design.ball_count: with ") + format_number(n) + " balls: " + e.what());
+      }
+    }
+  }
   const ObjectiveSettings& o = s.objective;
   if (o.kind == ObjectiveKind::Weighted && !(o.weight_mean > 0 || o.weight_pct_mi > 0))
     throw ConfigError("objective.weights", "{mean: " + format_number(o.weight_mean) + ", pct_mi: " +

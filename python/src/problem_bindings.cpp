@@ -121,7 +121,7 @@ class PyBatchProblem {
       opt::Evaluation e;
       {
         py::gil_scoped_release release;
-        e = p.evaluate_out_of_sample(p.profile_at(xi));
+        e = p.evaluate_out_of_sample_at(xi);  // the profile and, with design.ball_count, the balls at x
       }
       objective.mutable_at(i) = e.ok ? e.objective : INFINITY;
       violation.mutable_at(i) = opt::max_constraint_violation(e);

@@ -33,7 +33,7 @@ OutOfSampleComparison compare_out_of_sample(const problems::StartupProfileProble
   best_in.metrics = r.metrics;
   c.rows = {
       {"best, in-sample (" + std::to_string(st.study.runs) + ")", best_in},
-      {"best, out-of-sample (" + std::to_string(v.runs) + ")", as_optimised(problem.evaluate_out_of_sample(c.best))},
+      {"best, out-of-sample (" + std::to_string(v.runs) + ")", as_optimised(problem.evaluate_out_of_sample_at(r.x))},
       {"report profile, in-sample", as_optimised(problem.evaluate_profile(c.report))},
       {"report profile, out-of-sample", as_optimised(problem.evaluate_out_of_sample(c.report))},
   };

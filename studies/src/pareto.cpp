@@ -122,7 +122,7 @@ ParetoResult run_pareto(const problems::StartupProfileSettings& base, const opt:
     problems::StartupProfileProblem problem(base);
     for (auto& p : out.points) {
       p.out_of_sample = p.x.empty() ? opt::Evaluation::failed("no best point")
-                                    : problem.evaluate_out_of_sample(problem.profile_at(p.x));
+                                    : problem.evaluate_out_of_sample_at(p.x);
     }
     const StartupProfile report = StartupProfile::report_final();
     out.report_in_sample = problem.evaluate_profile(report);

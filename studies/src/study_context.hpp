@@ -2,7 +2,9 @@
 // What the stages of a study share (studies/src/study_runner.cpp builds it; one file per stage
 // kind: study_stage_global.cpp, study_stage_local.cpp, study_stage_replicate.cpp,
 // study_stage_validate.cpp).
+#include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,13 +15,26 @@ namespace abuopt::studies::detail {
 
 // One discrete choice (a ball count): its problem, archived, and where the next stage starts.
 struct ChoiceContext {
-  std::size_t balls = 0;
+  std::size_t index = 0;   // into StudyFile::choices
+  std::string label;       // "balls2", a set's name
+  std::size_t balls = 0;   // its ball count
+  bool active = true;      // choices.balls.mode: variable: false until a global stage chooses this count
   std::unique_ptr<problems::StartupProfileProblem> problem;
   std::unique_ptr<opt::EvaluationArchive> archive;
   std::unique_ptr<opt::ArchivedProblem> archived;
   std::vector<double> x;                 // the best design so far (empty: the family's x0)
   std::optional<std::size_t> last_design;  // the best design so far: index into StudyResult::designs
   std::vector<double> least_violation;   // per constraint: the smallest g_i seen (for "cannot be met")
+};
+
+// choices.balls.mode: variable: the problem with the ball count free (the global stages').
+struct VariableCountContext {
+  std::unique_ptr<problems::StartupProfileProblem> problem;
+  std::unique_ptr<opt::EvaluationArchive> archive;
+  std::unique_ptr<opt::ArchivedProblem> archived;
+  std::map<std::size_t, long> evaluations;    // per count: the global stages' evaluations there
+  std::map<std::size_t, double> best;         // per count: the best feasible objective (absent: none)
+  std::vector<double> least_violation;
 };
 
 struct StudyContext {
@@ -32,6 +47,7 @@ struct StudyContext {
   long total = 0;    // progress units planned
   bool interrupted = false;  // an optimiser stopped on SIGINT (its own handler ran, not the caller's)
   std::vector<ChoiceContext> choices;
+  std::optional<VariableCountContext> variable;  // choices.balls.mode: variable
 
   void log(const std::string& line) const;
   bool stop() const;
@@ -43,7 +59,7 @@ struct StudyContext {
     problems::StartupProfileSettings settings;
     opt::Evaluation baseline;
   };
-  Fresh fresh(std::size_t balls, std::uint64_t seed, std::size_t runs);
+  Fresh fresh(std::size_t choice, std::uint64_t seed, std::size_t runs);
   // The baseline's settings on a sample (seed, runs; 0: keep).
   problems::StartupProfileSettings baseline_sample(std::uint64_t seed, std::size_t runs) const;
   // Evaluates a profile under `s` through the archive (key: the problem identity and the profile).
@@ -52,12 +68,29 @@ struct StudyContext {
   problems::StartupProfileSettings baseline_settings() const;
 };
 
+// One optimiser run of a stage on one problem through its archive (an optimiser that takes bounds
+// only sees the exact-penalty form), at most max_evaluations (within the stage's own), from x0
+// (empty: the family's); counts the budget, the progress and the trace.
+struct OptimiserRun {
+  std::vector<double> best_x;  // the best feasible point (none feasible: the optimiser's last best; empty: no evaluation)
+  bool feasible = false;
+  StageTrace trace;
+};
+OptimiserRun run_archived_optimiser(StudyContext& c, const StageSpec& stage, const std::string& trace_name,
+                                    const ChoiceContext* choice, problems::StartupProfileProblem& problem,
+                                    opt::ArchivedProblem& archived, long max_evaluations, const std::vector<double>& x0,
+                                    std::vector<double>& least_violation);
+// A design of the study at x of `problem` (its in-sample evaluation from the archive).
+StudyDesign design_at(const ChoiceContext& ch, problems::StartupProfileProblem& problem, opt::ArchivedProblem& archived,
+                      const std::string& label, const std::string& stage, const std::vector<double>& x);
+
 // One optimiser stage on every choice (global: from the family's x0; local: from the best so far).
 void run_optimiser_stage(StudyContext& c, const StageSpec& stage, bool from_best);
 void run_global_stage(StudyContext& c, const StageSpec& stage);
 void run_local_stage(StudyContext& c, const StageSpec& stage);
 void run_replicate_stage(StudyContext& c, const StageSpec& stage);
 void run_validate_stage(StudyContext& c, const StageSpec& stage);
+void run_pareto_stage(StudyContext& c, const StageSpec& stage);
 // The final positions of the recommended design and the baseline over the equilibrium set (two
 // balls; studies/src/study_final_positions.cpp).
 void final_positions(StudyContext& c, const StudyDesign& d, std::uint64_t seed, std::size_t runs);

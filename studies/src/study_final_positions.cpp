@@ -15,10 +15,10 @@ namespace abuopt::studies::detail {
 namespace {
 
 std::vector<std::pair<double, double>> final_angles_deg(MonteCarloStudy st, const StartupProfile& p,
-                                                        std::size_t threads) {
+                                                        std::size_t threads, BatchRunner* given) {
   st.setup.profile = p;
-  ThreadPoolRunner runner(threads);
-  const MonteCarloResult r = run_monte_carlo(st, runner);
+  ThreadPoolRunner own(threads);
+  const MonteCarloResult r = run_monte_carlo(st, given ? *given : static_cast<BatchRunner&>(own));
   std::vector<std::pair<double, double>> out;
   for (const auto& s : r.samples)
     if (s.outcome.beta_final.size() == 2)
@@ -34,11 +34,12 @@ void final_positions(StudyContext& c, const StudyDesign& d, std::uint64_t seed, 
     c.log("final positions: drawn for two balls only");
     return;
   }
-  const StudyContext::Fresh fr = c.fresh(d.balls, seed, runs);
+  const StudyContext::Fresh fr = c.fresh(d.choice, seed, runs);
   const std::size_t threads = fr.settings.threads;
-  v.final_design = final_angles_deg(fr.settings.study, d.profile, threads);
-  v.final_baseline = final_angles_deg(c.baseline_sample(seed, runs).study, c.file.base.setup.profile, threads);
-  const AbuParameters abu = abu_of_choice(c.file, d.balls);
+  BatchRunner* runner = c.options.runner.get();  // e.g. MPI ranks
+  v.final_design = final_angles_deg(fr.settings.study, d.profile, threads, runner);
+  v.final_baseline = final_angles_deg(c.baseline_sample(seed, runs).study, c.file.base.setup.profile, threads, runner);
+  const AbuParameters abu = abu_of_choice(c.file, d.choice);
   const EquilibriumSet set(abu, abu.friction_mu);
   v.eq_frequency_hz = d.profile.segments().back().end_frequency_hz;
   v.eq_mu = abu.friction_mu;

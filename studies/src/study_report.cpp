@@ -67,7 +67,81 @@ std::string verdict_text(const ValidationResult& v) {
   return "No difference from the baseline that " + n + " can tell (the 95 % interval of the ratio contains 1).";
 }
 
+// Why the headline says what it says (after the headline's design).
+std::string headline_reason(Verdict v) {
+  switch (v) {
+    case Verdict::Recommended: return "feasible on every fresh sample and better than the baseline on fresh samples";
+    case Verdict::NoBetter:
+      return "no better than the baseline that the fresh samples can tell: the baseline is as good";
+    case Verdict::Worse: return "worse than the baseline on fresh samples: keep the baseline";
+    case Verdict::Candidate:
+      return "it did not meet the constraints on every fresh sample: a candidate to check, not an answer";
+    case Verdict::Unvalidated: return "in sample only (no validate stage): not checked on fresh samples";
+    case Verdict::None: return "";
+  }
+  return "";
+}
+
+std::string choices_sentence(const StudyFile& f, const StudyResult& r) {
+  std::ostringstream os;
+  const std::string won = r.recommended ? choice_name(f.choices[r.designs[*r.recommended].choice]) : "";
+  if (f.ball_count_variable) {
+    os << "The ball count was a variable of the global stages (";
+    for (std::size_t i = 0; i < r.choice_summary.size(); ++i)
+      os << (i ? ", " : "") << r.choice_summary[i].balls;
+    os << " balls at " << sig3(f.total_ball_mass_kg.value_or(0)) << " kg in all); they chose";
+    bool any = false;
+    for (const auto& cs : r.choice_summary)
+      if (cs.chosen) {
+        os << (any ? " and " : " ") << cs.balls << " balls";
+        any = true;
+      }
+    if (!any) os << " none";
+    os << ", which the later stages polished.";
+  } else {
+    os << "Every choice was optimised with the same stages";
+    if (f.total_ball_mass_kg) os << " (counts at " << sig3(*f.total_ball_mass_kg) << " kg in all)";
+    os << ".";
+  }
+  if (!won.empty()) os << " The best design has " << won << ".";
+  return os.str();
+}
+
 }  // namespace detail
+
+Verdict verdict_of(const StudyResult& r) {
+  if (!r.recommended) return Verdict::None;
+  if (r.candidate) return Verdict::Candidate;
+  const ValidationResult& v = r.validation;
+  if (!v.done || v.ratio_mean_ir.samples < 2) return Verdict::Unvalidated;
+  if (v.ratio_mean_ir.hi < 1.0) return Verdict::Recommended;
+  if (v.ratio_mean_ir.lo > 1.0) return Verdict::Worse;
+  return Verdict::NoBetter;
+}
+
+std::string to_string(Verdict v) {
+  switch (v) {
+    case Verdict::Recommended: return "recommended";
+    case Verdict::NoBetter: return "no_better";
+    case Verdict::Worse: return "worse";
+    case Verdict::Candidate: return "candidate";
+    case Verdict::Unvalidated: return "unvalidated";
+    case Verdict::None: return "none";
+  }
+  return "none";
+}
+
+std::string headline_of(Verdict v) {
+  switch (v) {
+    case Verdict::Recommended: return "Recommended design";
+    case Verdict::Candidate: return "Candidate design";
+    case Verdict::NoBetter:
+    case Verdict::Worse:
+    case Verdict::Unvalidated: return "Best design found";
+    case Verdict::None: return "No design is recommended";
+  }
+  return "";
+}
 
 namespace {
 
@@ -106,7 +180,7 @@ std::string indent(const std::string& text, const std::string& pad) {
 
 std::string design_yaml(const StudyFile& f, const StudyResult& r, const StudyDesign& d) {
   SimulationSetup setup = f.base.setup;
-  setup.abu = abu_of_choice(f, d.balls);
+  setup.abu = abu_of_choice(f, d.choice);
   setup.profile = d.profile;
   MonteCarloConfig mc;
   mc.study = f.base;
@@ -133,12 +207,14 @@ std::string markdown(const StudyFile& f, const StudyResult& r) {
   md << "# Study: " << f.title << "\n\n";
   const StudyDesign* rec = r.recommended ? &r.designs[*r.recommended] : nullptr;
   md << "## Answer\n\n";
+  const Verdict verdict = verdict_of(r);
   if (!rec) {
     md << "**No design is recommended.**";
     for (const auto& n : r.notes) md << " " << n << ".";
     md << "\n\n";
   } else {
-    md << "Recommended: **" << rec->label << "** - " << rec->balls << " balls, " << drive_text(f.base.setup.motor)
+    md << headline_of(verdict) << ": **" << rec->label << "** (" << headline_reason(verdict) << ") - " << rec->balls
+       << " balls, " << drive_text(f.base.setup.motor)
        << ", profile " << profile_text(rec->profile) << ", peak angular acceleration "
        << sig3(problems::peak_angular_acceleration_rad_s2(rec->profile)) << " rad/s^2 (baseline "
        << sig3(r.baseline_peak_acceleration) << ").\n\n";
@@ -146,23 +222,37 @@ std::string markdown(const StudyFile& f, const StudyResult& r) {
     if (v.done) {
       md << "On " << v.seeds.size() << " fresh samples of " << v.runs
          << " runs over the envelope (mean and 95 % interval over the samples):\n\n"
-         << "| | recommended | baseline |\n|---|---|---|\n";
-      const std::pair<const char*, const char*> rows[] = {{"ir_magnitude_mean", "mean |I_r| [1e-7 kg m]"},
-                                                         {"ir_magnitude_max", "max |I_r| [1e-7 kg m]"},
+         << "| | " << rec->label << " | baseline |\n|---|---|---|\n";
+      const std::pair<const char*, const char*> rows[] = {{"ir_magnitude_mean", "mean \\|I_r\\| [1e-7 kg m]"},
+                                                         {"ir_magnitude_max", "max \\|I_r\\| [1e-7 kg m]"},
                                                          {"pct_mi", "%MI"},
                                                          {"amplitude_max_mm", "peak amplitude [mm]"}};
       for (const auto& [k, label] : rows)
         md << "| " << label << " | " << interval_text(v.design.at(k)) << " | " << interval_text(v.baseline.at(k)) << " |\n";
-      md << "\nRatio of mean |I_r| (recommended / baseline): " << interval_text(v.ratio_mean_ir) << ". "
+      md << "\nRatio of mean |I_r| (" << rec->label << " / baseline): " << interval_text(v.ratio_mean_ir) << ". "
          << verdict_text(v) << "\n\n";
     }
+  }
+  if (r.choice_summary.size() > 1) {
+    md << "## Ball choices\n\n" << choices_sentence(f, r) << "\n\n| choice | balls | total ball mass [kg] | diameters [mm] | "
+       << "evaluations | best feasible objective in sample |" << (f.ball_count_variable ? " polished |" : "")
+       << "\n|---|---|---|---|---|---|" << (f.ball_count_variable ? "---|" : "") << "\n";
+    for (std::size_t i = 0; i < r.choice_summary.size(); ++i) {
+      const auto& cs = r.choice_summary[i];
+      double mass = 0;
+    for (const Ball& b : f.choices[i].balls) mass += b.mass_kg;
+      md << "| " << cs.label << " | " << cs.balls << " | " << sig3(mass) << " | " << diameters_mm(f.choices[i].balls) << " | "
+         << cs.evaluations << " | " << (std::isfinite(cs.best_feasible) ? sig3(cs.best_feasible) : "none feasible")
+         << " |" << (f.ball_count_variable ? (cs.chosen ? " yes |" : " no |") : "") << "\n";
+    }
+    md << "\n";
   }
   if (!r.notes.empty()) {
     md << "## Notes\n\n";
     for (const auto& n : r.notes) md << "- " << n << "\n";
     md << "\n";
   }
-  md << "## Designs\n\n| design | balls | stage | objective (in sample) | objective (replicated) | feasible | mean |I_r| | "
+  md << "## Designs\n\n| design | balls | stage | objective (in sample) | objective (replicated) | feasible | mean \\|I_r\\| | "
         "%MI | peak amplitude [mm] | T [s] | profile |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
   md << "| baseline | " << f.base.setup.abu.balls.size() << " | - | " << sig3(r.baseline.objective) << " | - | "
      << (feasible(r.baseline) ? "yes" : "no") << " | " << sig3(metric(r.baseline, "ir_magnitude_mean")) << " | "
@@ -175,9 +265,31 @@ std::string markdown(const StudyFile& f, const StudyResult& r) {
        << " | " << sig3(metric(d.in_sample, "ir_magnitude_mean")) << " | " << sig3(metric(d.in_sample, "pct_mi"))
        << " | " << sig3(metric(d.in_sample, "amplitude_max_mm")) << " | " << sig3(d.profile.duration_s()) << " | "
        << profile_text(d.profile) << " |\n";
-  md << "\n## Stages\n\n| stage | balls | algorithm | reason | evaluations | from archive |\n|---|---|---|---|---|---|\n";
+  if (!r.front.points.empty()) {
+    const ParetoFront& fr = r.front;
+    const bool oos = !fr.seeds.empty();
+    md << "\n## Pareto front (stage " << fr.stage << ")\n\nThe least objective at each bound on the startup time T "
+       << "(epsilon-constraint), mean |I_r| in 1e-7 kg m; "
+       << (oos ? "in sample and on " + std::to_string(fr.seeds.size()) + " fresh samples of " + std::to_string(fr.runs) +
+                     " runs (mean and 95 % interval).\n\n"
+               : "in sample only (biased low: the optimiser chose on that sample).\n\n")
+       << "| bound on T [s] | balls | T [s] | mean \\|I_r\\| in sample | " << (oos ? "mean \\|I_r\\| fresh | feasible fresh | " : "")
+       << "%MI | feasible | dominated | config |\n|---|---|---|---|" << (oos ? "---|---|" : "") << "---|---|---|---|\n";
+    for (const FrontPoint& p : fr.points) {
+      md << "| " << sig3(p.bound_s) << " | " << p.design.balls << " | " << sig3(p.design.profile.duration_s()) << " | "
+         << sig3(metric(p.design.in_sample, "ir_magnitude_mean")) << " | ";
+      if (oos) md << interval_text(p.out_of_sample_ir) << " | " << (p.feasible_out_of_sample ? "yes" : "no") << " | ";
+      md << sig3(metric(p.design.in_sample, "pct_mi")) << " | " << (p.feasible ? "yes" : "no") << " | "
+         << (p.dominated ? "yes" : "no") << " | designs/" << p.design.label << ".yaml |\n";
+    }
+    md << "| baseline | " << f.base.setup.abu.balls.size() << " | " << sig3(f.base.setup.profile.duration_s()) << " | "
+       << sig3(metric(r.baseline, "ir_magnitude_mean")) << " | ";
+    if (oos) md << interval_text(fr.baseline_out_of_sample_ir) << " | - | ";
+    md << sig3(metric(r.baseline, "pct_mi")) << " | - | - | - |\n";
+  }
+  md << "\n## Stages\n\n| stage | choice | algorithm | reason | evaluations | from archive |\n|---|---|---|---|---|---|\n";
   for (const auto& t : r.traces)
-    md << "| " << t.stage << " | " << t.balls << " | " << t.algorithm << " | " << t.reason << " | " << t.evaluations
+    md << "| " << t.stage << " | " << (t.balls ? t.choice : std::string("ball count a variable")) << " | " << t.algorithm << " | " << t.reason << " | " << t.evaluations
        << " | " << t.archive_hits << " |\n";
   md << "\nObjective: " << to_string(f.objective.kind) << " (I_r in 1e-7 kg m); " << f.base.runs
      << " runs per evaluation on the same initial angles (common random numbers), seed " << f.base.seed
@@ -221,6 +333,7 @@ nlohmann::json summary(const StudyFile& f, const StudyResult& r) {
   }
   j["designs"] = designs;
   j["recommended"] = r.recommended ? nlohmann::json(r.designs[*r.recommended].label) : nlohmann::json(nullptr);
+  j["verdict"] = to_string(verdict_of(r));
   if (r.validation.done) {
     const ValidationResult& v = r.validation;
     nlohmann::json dv = nlohmann::json::object(), bv = nlohmann::json::object();
@@ -232,11 +345,53 @@ nlohmann::json summary(const StudyFile& f, const StudyResult& r) {
       j["validation"]["map"] = {{"friction_mu", v.map_mu}, {"imbalance_mass_factor", v.map_imbalance},
                                 {"runs", v.map_runs}, {"ratio_mean_abs_ir", v.map_ratio}};
   }
+  if (!r.front.points.empty()) {
+    const ParetoFront& fr = r.front;
+    nlohmann::json pts = nlohmann::json::array();
+    for (const FrontPoint& p : fr.points) {
+      nlohmann::json x = nlohmann::json::object();
+      for (std::size_t i = 0; i < p.design.x.size() && i < p.design.variable_names.size(); ++i)
+        x[p.design.variable_names[i]] = p.design.x[i];
+      nlohmann::json jp = {{"bound_s", p.bound_s},
+                           {"label", p.design.label},
+                           {"balls", p.design.balls},
+                           {"startup_time_s", p.design.profile.duration_s()},
+                           {"x", x},
+                           {"profile", profile_json(p.design.profile)},
+                           {"in_sample", evaluation_json(p.design.in_sample, r.constraint_names)},
+                           {"feasible", p.feasible},
+                           {"dominated", p.dominated},
+                           {"evaluations", p.evaluations},
+                           {"file", "designs/" + p.design.label + ".yaml"}};
+      if (!fr.seeds.empty()) {
+        jp["out_of_sample_mean_abs_ir"] = interval_json(p.out_of_sample_ir);
+        jp["feasible_out_of_sample"] = p.feasible_out_of_sample;
+      }
+      pts.push_back(jp);
+    }
+    j["pareto"] = {{"stage", fr.stage}, {"points", pts}};
+    if (!fr.seeds.empty()) {
+      j["pareto"]["seeds"] = fr.seeds;
+      j["pareto"]["runs"] = fr.runs;
+      j["pareto"]["baseline_out_of_sample_mean_abs_ir"] = interval_json(fr.baseline_out_of_sample_ir);
+    }
+  }
+  j["choices"] = nlohmann::json::array();
+  for (std::size_t i = 0; i < r.choice_summary.size(); ++i) {
+    const auto& cs = r.choice_summary[i];
+    nlohmann::json balls = nlohmann::json::array();
+    for (const Ball& b : f.choices[i].balls) balls.push_back({{"mass_kg", b.mass_kg}, {"diameter_m", b.diameter_m}});
+    j["choices"].push_back({{"label", cs.label}, {"balls", balls}, {"evaluations", cs.evaluations},
+                            {"best_feasible_objective", std::isfinite(cs.best_feasible) ? nlohmann::json(cs.best_feasible)
+                                                                                        : nlohmann::json(nullptr)},
+                            {"chosen", cs.chosen}});
+  }
+  j["ball_count_variable"] = f.ball_count_variable;
   j["traces"] = nlohmann::json::array();
   for (const auto& t : r.traces) {
     nlohmann::json best = nlohmann::json::array();
     for (double b : t.best_feasible) best.push_back(std::isfinite(b) ? nlohmann::json(b) : nlohmann::json(nullptr));
-    j["traces"].push_back({{"stage", t.stage}, {"balls", t.balls}, {"algorithm", t.algorithm}, {"reason", t.reason},
+    j["traces"].push_back({{"stage", t.stage}, {"choice", t.choice}, {"balls", t.balls}, {"algorithm", t.algorithm}, {"reason", t.reason},
                            {"evaluations", t.evaluations}, {"archive_hits", t.archive_hits}, {"best_feasible", best}});
   }
   return j;
@@ -251,6 +406,11 @@ std::vector<std::string> write_study_report(const StudyFile& f, const StudyResul
   for (const auto& d : r.designs) {
     const fs::path p = out / "designs" / (d.label + ".yaml");
     write_file_atomic(p, design_yaml(f, r, d));
+    files.push_back(p.string());
+  }
+  for (const auto& fp : r.front.points) {
+    const fs::path p = out / "designs" / (fp.design.label + ".yaml");
+    write_file_atomic(p, design_yaml(f, r, fp.design));
     files.push_back(p.string());
   }
   write_file_atomic(out / "summary.json", summary(f, r).dump(2) + "\n");

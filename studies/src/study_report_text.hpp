@@ -19,6 +19,10 @@ double metric(const opt::Evaluation& e, const std::string& key);
 std::string drive_text(const MotorModel& m);
 // One sentence: better than the baseline, worse, or no difference the samples can tell.
 std::string verdict_text(const ValidationResult& v);
+// Why the headline says what it says ("feasible on every fresh sample and better than ...").
+std::string headline_reason(Verdict v);
+// How the ball choices did, in one or two sentences (which count or set won).
+std::string choices_sentence(const StudyFile& f, const StudyResult& r);
 // The HTML report (study_report_html.cpp).
 std::string study_html(const StudyFile& f, const StudyResult& r);
 

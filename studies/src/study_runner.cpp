@@ -60,10 +60,10 @@ problems::StartupProfileSettings StudyContext::baseline_sample(std::uint64_t see
   return s;
 }
 
-StudyContext::Fresh StudyContext::fresh(std::size_t balls, std::uint64_t seed, std::size_t runs) {
+StudyContext::Fresh StudyContext::fresh(std::size_t choice, std::uint64_t seed, std::size_t runs) {
   Fresh r;
   r.baseline = evaluate_profile(baseline_sample(seed, runs), file.base.setup.profile);
-  r.settings = settings_of_choice(file, balls, r.baseline.metrics);
+  r.settings = settings_of_choice(file, choice, r.baseline.metrics);
   r.settings.study.seed = seed;
   r.settings.study.design.seed = seed;
   if (runs > 0) r.settings.study.runs = runs;
@@ -72,7 +72,7 @@ StudyContext::Fresh StudyContext::fresh(std::size_t balls, std::uint64_t seed, s
 }
 
 problems::StartupProfileSettings StudyContext::baseline_settings() const {
-  problems::StartupProfileSettings s = settings_of_choice(file, file.ball_counts.front(), {});
+  problems::StartupProfileSettings s = settings_of_choice(file, 0, {});
   s.study.setup.abu = file.base.setup.abu;  // the ABU as given
   s.study.design.balls = s.study.setup.abu.balls.size();
   s.constraints = file.constraints;  // absolute bounds only (the relative ones are relative to it)
@@ -82,6 +82,7 @@ problems::StartupProfileSettings StudyContext::baseline_settings() const {
 
 opt::Evaluation StudyContext::evaluate_profile(const problems::StartupProfileSettings& s, const StartupProfile& p) {
   problems::StartupProfileProblem problem(s);
+  if (options.runner) problem.set_monte_carlo_runner(options.runner);
   const std::string id = problem.identity() + "/profile-" + hex16(problems::fnv1a64(write_fields(p)));
   opt::EvaluationArchive archive(archive_path, id);
   const std::vector<double> key = {0.0};
@@ -97,105 +98,175 @@ opt::Evaluation StudyContext::evaluate_profile(const problems::StartupProfileSet
   return e;
 }
 
+OptimiserRun run_archived_optimiser(StudyContext& c, const StageSpec& stage, const std::string& trace_name,
+                                    const ChoiceContext* choice, problems::StartupProfileProblem& problem,
+                                    opt::ArchivedProblem& archived, long max_evaluations, const std::vector<double>& x0,
+                                    std::vector<double>& least_violation) {
+  OptimiserRun run;
+  opt::OptimizerOptions o = stage.optimizer;
+  o.max_evaluations = std::min(o.max_evaluations, max_evaluations);
+  const opt::AlgorithmInfo& info = opt::find_algorithm(o.algorithm, "stages." + stage.name + ".optimizer.algorithm");
+  const std::vector<std::string> g_names = problem.inequality_names();
+  std::optional<opt::PenaltyProblem> pen;
+  if (!info.inequality_constraints && !g_names.empty()) pen.emplace(archived, stage.penalty_weight);
+  opt::Problem& p = pen ? static_cast<opt::Problem&>(*pen) : static_cast<opt::Problem&>(archived);
+
+  StageTrace& tr = run.trace;
+  tr.stage = trace_name;
+  tr.choice = choice ? choice->label : "variable count";
+  tr.balls = choice ? choice->balls : 0;
+  VariableCountContext* var = choice ? nullptr : (c.variable ? &*c.variable : nullptr);
+  double best = std::numeric_limits<double>::infinity();
+  least_violation.resize(g_names.size(), std::numeric_limits<double>::infinity());
+  const opt::EvaluationCallback cb = [&](const opt::Progress& pr) {
+    const opt::EvaluationRecord& rec = pr.last;
+    double obj = rec.objective;
+    std::vector<double> g = rec.inequality;
+    if (pen) {  // the real objective and constraints, from the penalty form's metrics
+      auto it = rec.metrics.find("objective_without_penalty");
+      if (it != rec.metrics.end()) obj = it->second;
+      g.clear();
+      for (const auto& n : g_names) {
+        auto gi = rec.metrics.find("g_" + n);
+        g.push_back(gi == rec.metrics.end() ? kNaN : gi->second);
+      }
+    }
+    bool feas = rec.ok && std::isfinite(obj);
+    for (std::size_t i = 0; i < g.size() && i < g_names.size(); ++i) {
+      if (rec.ok && std::isfinite(g[i])) least_violation[i] = std::min(least_violation[i], g[i]);
+      feas = feas && std::isfinite(g[i]) && g[i] <= kTolerance;
+    }
+    tr.objective.push_back(rec.ok ? obj : kNaN);
+    if (feas && obj < best) {
+      best = obj;
+      run.best_x = rec.x;
+    }
+    tr.best_feasible.push_back(std::isfinite(best) ? best : kNaN);
+    if (var && rec.x.size() == problem.variables().size()) {  // how each count did
+      const std::size_t n = problem.balls_at(rec.x);
+      ++var->evaluations[n];
+      if (feas && (!var->best.count(n) || obj < var->best[n])) var->best[n] = obj;
+    }
+    c.tick();
+    return !c.stop();
+  };
+  std::ostringstream head;
+  head << "stage " << trace_name << " ("
+       << (choice ? choice_name(c.file.choices[choice->index]) : "the ball count a variable")
+       << "): " << o.algorithm << (pen ? " (penalty form)" : "")
+       << ", at most " << o.max_evaluations << " evaluations, from "
+       << (x0.empty() ? "the family's starting point" : "the previous best");
+  c.log(head.str());
+  const opt::OptimizationResult r = opt::minimize(p, o, x0, cb);
+  c.used += r.evaluations;
+  if (r.reason == opt::TerminationReason::Interrupted) c.interrupted = true;
+  tr.algorithm = r.algorithm;
+  tr.reason = to_string(r.reason);
+  tr.evaluations = r.evaluations;
+  tr.archive_hits = r.archive_hits;
+  c.result.evaluations += r.evaluations;
+  c.result.archive_hits += r.archive_hits;
+  run.feasible = !run.best_x.empty();
+  if (run.best_x.empty()) run.best_x = r.x;  // nothing feasible: the optimiser's least bad point
+  return run;
+}
+
+StudyDesign design_at(const ChoiceContext& ch, problems::StartupProfileProblem& problem, opt::ArchivedProblem& archived,
+                      const std::string& label, const std::string& stage, const std::vector<double>& x) {
+  StudyDesign d;
+  d.label = label;
+  d.choice = ch.index;
+  d.balls = ch.balls;
+  d.stage = stage;
+  for (const auto& v : problem.variables()) d.variable_names.push_back(v.name);
+  d.x = x;
+  d.profile = problem.profile_at(x);
+  d.in_sample = archived.evaluate(x);  // an archive hit
+  d.robust_feasible = feasible(d.in_sample);
+  d.replicated_objective = d.in_sample.objective;
+  return d;
+}
+
+namespace {
+
+// The best design of an optimiser stage for one choice at x: the choice's best so far, and its
+// design recorded (a stage that found nothing better keeps the previous best as the start).
+void record_stage_design(StudyContext& c, ChoiceContext& ch, const StageSpec& stage, const std::vector<double>& x,
+                         const StageTrace& trace) {
+  const StudyDesign d = design_at(ch, *ch.problem, *ch.archived, ch.label + "_" + stage.name, stage.name, x);
+  // the next stage starts from the best design so far (a stage that found nothing better keeps it)
+  const auto better = [](const StudyDesign& a, const StudyDesign& b) {
+    const bool fa = feasible(a.in_sample), fb = feasible(b.in_sample);
+    if (fa != fb) return fa;
+    if (fa) return a.in_sample.objective < b.in_sample.objective;
+    return opt::max_constraint_violation(a.in_sample) < opt::max_constraint_violation(b.in_sample);
+  };
+  if (!ch.last_design || better(d, c.result.designs[*ch.last_design])) {
+    ch.x = x;
+    ch.last_design = c.result.designs.size();
+  } else {
+    c.log("  not better than " + c.result.designs[*ch.last_design].label + ": the next stage starts from that one");
+  }
+  c.result.designs.push_back(d);
+  std::ostringstream done;
+  done << "  " << trace.reason << " after " << trace.evaluations << " evaluations (" << trace.archive_hits
+       << " from the archive): " << ch.label << ", objective " << g4(d.in_sample.objective)
+       << (d.robust_feasible ? " (feasible)" : " (NOT feasible)");
+  c.log(done.str());
+}
+
+// choices.balls.mode: variable, a global stage: one run over the profile and the ball count; the
+// count of its best point becomes a choice the later stages polish (from that point's profile).
+void run_variable_count_stage(StudyContext& c, const StageSpec& stage) {
+  VariableCountContext& v = *c.variable;
+  const long remaining = c.file.max_evaluations - c.used;
+  if (remaining <= 0) {
+    c.result.notes.push_back("stage " + stage.name + " skipped: the budget (budget.max_evaluations = " +
+                             std::to_string(c.file.max_evaluations) + ") is spent");
+    c.log(c.result.notes.back());
+    return;
+  }
+  OptimiserRun run = run_archived_optimiser(c, stage, stage.name, nullptr, *v.problem, *v.archived, remaining, {},
+                                            v.least_violation);
+  c.result.traces.push_back(run.trace);
+  if (run.best_x.empty()) return;
+  const std::size_t n = v.problem->balls_at(run.best_x);
+  const std::size_t k = *v.problem->ball_count_variable();
+  std::vector<double> x = run.best_x;
+  x.erase(x.begin() + static_cast<std::ptrdiff_t>(k));  // the profile's coordinates
+  for (ChoiceContext& ch : c.choices) {
+    if (ch.balls != n) continue;
+    c.log("  the count chosen: " + std::to_string(n) + " balls (" + (run.feasible ? "feasible" : "none feasible: the least bad") +
+          "); the later stages polish it");
+    ch.active = true;
+    record_stage_design(c, ch, stage, x, run.trace);
+  }
+}
+
+}  // namespace
+
 void run_optimiser_stage(StudyContext& c, const StageSpec& stage, bool from_best) {
+  if (c.variable && !from_best) {
+    run_variable_count_stage(c, stage);
+    return;
+  }
   for (ChoiceContext& ch : c.choices) {
     if (c.stop()) return;
+    if (!ch.active) continue;
     const long remaining = c.file.max_evaluations - c.used;
     if (remaining <= 0) {
-      c.result.notes.push_back("stage " + stage.name + " skipped for " + std::to_string(ch.balls) +
-                               " balls: the budget (budget.max_evaluations = " +
-                               std::to_string(c.file.max_evaluations) + ") is spent");
+      c.result.notes.push_back("stage " + stage.name + " skipped for " + ch.label +
+                               ": the budget (budget.max_evaluations = " + std::to_string(c.file.max_evaluations) +
+                               ") is spent");
       c.log(c.result.notes.back());
       continue;
     }
-    opt::OptimizerOptions o = stage.optimizer;
-    o.max_evaluations = std::min(o.max_evaluations, remaining);
-    const opt::AlgorithmInfo& info = opt::find_algorithm(o.algorithm, "stages." + stage.name + ".optimizer.algorithm");
-    const std::vector<std::string> g_names = ch.problem->inequality_names();
-    std::optional<opt::PenaltyProblem> pen;
-    if (!info.inequality_constraints && !g_names.empty()) pen.emplace(*ch.archived, stage.penalty_weight);
-    opt::Problem& p = pen ? static_cast<opt::Problem&>(*pen) : static_cast<opt::Problem&>(*ch.archived);
-    std::vector<double> x0 = from_best ? ch.x : std::vector<double>{};
-
-    StageTrace tr;
-    tr.stage = stage.name;
-    tr.balls = ch.balls;
-    std::vector<double> best_x;
-    double best = std::numeric_limits<double>::infinity();
-    ch.least_violation.resize(g_names.size(), std::numeric_limits<double>::infinity());
-    const opt::EvaluationCallback cb = [&](const opt::Progress& pr) {
-      const opt::EvaluationRecord& rec = pr.last;
-      double obj = rec.objective;
-      std::vector<double> g = rec.inequality;
-      if (pen) {  // the real objective and constraints, from the penalty form's metrics
-        auto it = rec.metrics.find("objective_without_penalty");
-        if (it != rec.metrics.end()) obj = it->second;
-        g.clear();
-        for (const auto& n : g_names) {
-          auto gi = rec.metrics.find("g_" + n);
-          g.push_back(gi == rec.metrics.end() ? kNaN : gi->second);
-        }
-      }
-      bool feas = rec.ok && std::isfinite(obj);
-      for (std::size_t i = 0; i < g.size() && i < g_names.size(); ++i) {
-        if (rec.ok && std::isfinite(g[i])) ch.least_violation[i] = std::min(ch.least_violation[i], g[i]);
-        feas = feas && std::isfinite(g[i]) && g[i] <= kTolerance;
-      }
-      tr.objective.push_back(rec.ok ? obj : kNaN);
-      if (feas && obj < best) {
-        best = obj;
-        best_x = rec.x;
-      }
-      tr.best_feasible.push_back(std::isfinite(best) ? best : kNaN);
-      c.tick();
-      return !c.stop();
-    };
-    std::ostringstream head;
-    head << "stage " << stage.name << " (" << ch.balls << " balls): " << o.algorithm << (pen ? " (penalty form)" : "")
-         << ", at most " << o.max_evaluations << " evaluations, from "
-         << (x0.empty() ? "the family's starting point" : "the previous best");
-    c.log(head.str());
-    const opt::OptimizationResult r = opt::minimize(p, o, x0, cb);
-    c.used += r.evaluations;
-    if (r.reason == opt::TerminationReason::Interrupted) c.interrupted = true;
-    tr.algorithm = r.algorithm;
-    tr.reason = to_string(r.reason);
-    tr.evaluations = r.evaluations;
-    tr.archive_hits = r.archive_hits;
-    c.result.evaluations += r.evaluations;
-    c.result.archive_hits += r.archive_hits;
-    c.result.traces.push_back(tr);
-    if (best_x.empty()) best_x = r.x;  // nothing feasible: the optimiser's least bad point
-    if (best_x.empty()) continue;     // no evaluation at all (interrupted at once)
-    StudyDesign d;
-    d.label = "balls" + std::to_string(ch.balls) + "_" + stage.name;
-    d.balls = ch.balls;
-    d.stage = stage.name;
-    for (const auto& v : ch.problem->variables()) d.variable_names.push_back(v.name);
-    d.x = best_x;
-    d.profile = ch.problem->profile_at(best_x);
-    d.in_sample = ch.archived->evaluate(best_x);  // an archive hit
-    d.robust_feasible = feasible(d.in_sample);
-    d.replicated_objective = d.in_sample.objective;
-    // the next stage starts from the best design so far (a stage that found nothing better keeps it)
-    const auto better = [](const StudyDesign& a, const StudyDesign& b) {
-      const bool fa = feasible(a.in_sample), fb = feasible(b.in_sample);
-      if (fa != fb) return fa;
-      if (fa) return a.in_sample.objective < b.in_sample.objective;
-      return opt::max_constraint_violation(a.in_sample) < opt::max_constraint_violation(b.in_sample);
-    };
-    if (!ch.last_design || better(d, c.result.designs[*ch.last_design])) {
-      ch.x = best_x;
-      ch.last_design = c.result.designs.size();
-    } else {
-      c.log("  not better than " + c.result.designs[*ch.last_design].label + ": the next stage starts from that one");
-    }
-    c.result.designs.push_back(d);
-    std::ostringstream done;
-    done << "  " << tr.reason << " after " << r.evaluations << " evaluations (" << r.archive_hits
-         << " from the archive): objective " << g4(d.in_sample.objective)
-         << (d.robust_feasible ? " (feasible)" : " (NOT feasible)");
-    c.log(done.str());
+    const std::vector<double> x0 = from_best ? ch.x : std::vector<double>{};
+    OptimiserRun run = run_archived_optimiser(c, stage, stage.name, &ch, *ch.problem, *ch.archived, remaining, x0,
+                                              ch.least_violation);
+    c.result.traces.push_back(run.trace);
+    if (run.best_x.empty()) continue;  // no evaluation at all (interrupted at once)
+    record_stage_design(c, ch, stage, run.best_x, run.trace);
   }
 }
 
@@ -217,20 +288,14 @@ StudyResult run_study(const StudyFile& f, const StudyRunOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
   StudyResult result;
   fs::create_directories(o.out);
-  StudyContext c{f, o, result, (fs::path(o.out) / "archive.sqlite").string(), 0, 0, 0, {}};
+  StudyContext c{f, o, result, (fs::path(o.out) / "archive.sqlite").string(), 0, 0, 0, false, {}, {}};
   const Provenance prov = provenance_of(f.path);
 
-  // the plan, for the progress line: optimiser budgets, fresh samples, map points
-  long optimiser = 0, other = 1;  // 1: the baseline
-  for (const StageSpec& s : f.stages) {
-    if (s.kind == StageKind::Global || s.kind == StageKind::Local)
-      optimiser += s.optimizer.max_evaluations * static_cast<long>(f.ball_counts.size());
-    else if (s.kind == StageKind::Replicate)
-      other += static_cast<long>(s.seeds.size() * (f.ball_counts.size() + 1));
-    else
-      other += static_cast<long>(2 * s.seeds.size() + 2 * s.map_friction_mu.size() * s.map_imbalance_factor.size());
-  }
-  c.total = std::min(optimiser, f.max_evaluations) + other;
+  // the plan, for the progress line (studies/src/study_plan.cpp counts the same)
+  const StudyPlan plan = plan_of(f);
+  const long optimiser = static_cast<long>(plan.optimiser_evaluations);
+  const long other = static_cast<long>(plan.other_evaluations);
+  c.total = optimiser + other;
 
   // the baseline on the in-sample initial conditions (its metrics fix the relative constraints)
   result.baseline = c.evaluate_profile(c.baseline_settings(), f.base.setup.profile);
@@ -246,27 +311,46 @@ StudyResult run_study(const StudyFile& f, const StudyRunOptions& o) {
     c.log(os.str());
   }
 
-  for (std::size_t n : f.ball_counts) {
+  for (std::size_t i = 0; i < f.choices.size(); ++i) {
     ChoiceContext ch;
-    ch.balls = n;
-    problems::StartupProfileSettings s = settings_of_choice(f, n, result.baseline.metrics);
+    ch.index = i;
+    ch.label = f.choices[i].label;
+    ch.balls = f.choices[i].balls.size();
+    ch.active = !f.ball_count_variable;  // variable: a global stage chooses the count(s) the others polish
+    problems::StartupProfileSettings s = settings_of_choice(f, i, result.baseline.metrics);
     if (o.threads) s.threads = *o.threads;
     const double fn = s.study.setup.abu.natural_frequency_hz();
     ch.problem = std::make_unique<problems::StartupProfileProblem>(s);
+    if (o.runner) ch.problem->set_monte_carlo_runner(o.runner);
     ch.archive = std::make_unique<opt::EvaluationArchive>(c.archive_path, ch.problem->identity());
     ch.archive->record_metadata("study", f.path, prov.config_hash);
     ch.archived = std::make_unique<opt::ArchivedProblem>(*ch.problem, *ch.archive);
     result.constraint_names = ch.problem->inequality_names();
     std::ostringstream os;
-    os << n << " balls: natural frequency " << format_number(std::round(fn * 100) / 100) << " Hz, "
-       << ch.problem->variables().size() << " variables, " << ch.archive->count() << " stored evaluations";
+    os << ch.label << " (" << ch.balls << " balls): natural frequency " << format_number(std::round(fn * 100) / 100)
+       << " Hz, " << ch.problem->variables().size() << " variables, " << ch.archive->count() << " stored evaluations";
     c.log(os.str());
     const std::string reach = resonance_reach_text(s.design, fn);
-    if (!reach.empty()) {
-      result.notes.push_back(std::to_string(n) + " balls: " + reach);
+    if (!reach.empty() && (i == 0 || !f.ball_count_variable)) {
+      result.notes.push_back(choice_name(f.choices[i]) + ": " + reach);
       c.log("note: " + result.notes.back());
     }
     c.choices.push_back(std::move(ch));
+  }
+  if (f.ball_count_variable) {
+    VariableCountContext v;
+    problems::StartupProfileSettings s = settings_of_variable_count(f, result.baseline.metrics);
+    if (o.threads) s.threads = *o.threads;
+    v.problem = std::make_unique<problems::StartupProfileProblem>(s);
+    if (o.runner) v.problem->set_monte_carlo_runner(o.runner);
+    v.archive = std::make_unique<opt::EvaluationArchive>(c.archive_path, v.problem->identity());
+    v.archive->record_metadata("study", f.path, prov.config_hash);
+    v.archived = std::make_unique<opt::ArchivedProblem>(*v.problem, *v.archive);
+    const auto& b = s.design.ball_count;
+    c.log("the ball count is a variable of the global stages: " + format_number(b.lower) + " to " +
+          format_number(b.upper) + " balls at " + format_number(b.total_mass_kg) + " kg (" +
+          std::to_string(v.archive->count()) + " stored evaluations)");
+    c.variable = std::move(v);
   }
 
   bool replicated = false;
@@ -276,6 +360,7 @@ StudyResult run_study(const StudyFile& f, const StudyRunOptions& o) {
       switch (s.kind) {
         case StageKind::Global: run_global_stage(c, s); break;
         case StageKind::Local: run_local_stage(c, s); break;
+        case StageKind::Pareto: run_pareto_stage(c, s); break;
         case StageKind::Replicate:
           run_replicate_stage(c, s);
           replicated = true;
@@ -296,14 +381,45 @@ StudyResult run_study(const StudyFile& f, const StudyRunOptions& o) {
   if (!replicated) recommend_in_sample(c);
   result.interrupted = c.stop();
 
+  // how each choice did
+  for (const ChoiceContext& ch : c.choices) {
+    StudyResult::ChoiceSummary cs;
+    cs.label = ch.label;
+    cs.balls = ch.balls;
+    cs.best_feasible = kNaN;
+    if (c.variable) {
+      cs.chosen = ch.active;
+      auto e = c.variable->evaluations.find(ch.balls);
+      cs.evaluations = e == c.variable->evaluations.end() ? 0 : e->second;
+      auto b = c.variable->best.find(ch.balls);
+      if (b != c.variable->best.end()) cs.best_feasible = b->second;
+    } else {
+      for (const StageTrace& t : result.traces)
+        if (t.choice == ch.label) cs.evaluations += t.evaluations;
+      if (ch.last_design && feasible(result.designs[*ch.last_design].in_sample))
+        cs.best_feasible = result.designs[*ch.last_design].in_sample.objective;
+      cs.chosen = result.recommended && result.designs[*result.recommended].choice == ch.index;
+    }
+    result.choice_summary.push_back(cs);
+  }
+  if (c.variable) {
+    std::ostringstream os;
+    os << "the ball count as a variable:";
+    for (const auto& cs : result.choice_summary)
+      os << " " << cs.balls << " balls " << cs.evaluations << " evaluations, best " << (std::isfinite(cs.best_feasible) ? g4(cs.best_feasible) : std::string("none feasible"))
+         << (cs.chosen ? " (chosen)" : "") << ";";
+    c.log(os.str());
+  }
+
   // a constraint that no evaluation met, named with its least value
   if (!result.interrupted && !result.recommended) {
     for (const ChoiceContext& ch : c.choices)
       for (std::size_t i = 0; i < ch.least_violation.size() && i < result.constraint_names.size(); ++i)
         if (ch.least_violation[i] > kTolerance) {
           std::ostringstream os;
-          os << "constraint " << result.constraint_names[i] << " cannot be met with " << ch.balls
-             << " balls: its least value over every evaluation is g = " << g4(ch.least_violation[i])
+          os << "constraint " << result.constraint_names[i] << " cannot be met with "
+             << choice_name(f.choices[ch.index])
+             << ": its least value over every evaluation is g = " << g4(ch.least_violation[i])
              << " (the bound exceeded by " << format_number(std::round(ch.least_violation[i] * 1000) / 10) << " %)";
           result.notes.push_back(os.str());
           c.log("note: " + os.str());

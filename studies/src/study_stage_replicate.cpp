@@ -21,7 +21,7 @@ void run_replicate_stage(StudyContext& c, const StageSpec& stage) {
     bool all = true;
     for (std::uint64_t seed : stage.seeds) {
       if (c.stop()) return;
-      const opt::Evaluation e = c.evaluate_profile(c.fresh(ch.balls, seed, stage.runs).settings, d.profile);
+      const opt::Evaluation e = c.evaluate_profile(c.fresh(ch.index, seed, stage.runs).settings, d.profile);
       d.replications.push_back(e);
       sum += e.objective;
       all = all && feasible(e);
@@ -29,7 +29,7 @@ void run_replicate_stage(StudyContext& c, const StageSpec& stage) {
     d.robust_feasible = all;
     d.replicated_objective = sum / static_cast<double>(d.replications.size());
     std::ostringstream os;
-    os << "stage " << stage.name << " (" << ch.balls << " balls): " << d.label << " on " << stage.seeds.size()
+    os << "stage " << stage.name << " (" << ch.label << "): " << d.label << " on " << stage.seeds.size()
        << " fresh samples: mean objective " << format_number(std::round(d.replicated_objective * 1000) / 1000)
        << (all ? ", feasible on every one" : ", NOT feasible on every one");
     c.log(os.str());
@@ -43,6 +43,7 @@ void run_replicate_stage(StudyContext& c, const StageSpec& stage) {
   }
   if (!c.result.recommended) {
     recommend_in_sample(c);
+    c.result.candidate = c.result.recommended.has_value();
     c.result.notes.push_back(
         c.result.recommended
             ? "no design met the constraints on every fresh sample; the recommendation is the best in-sample design, "

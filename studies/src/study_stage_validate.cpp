@@ -50,7 +50,7 @@ void run_validate_stage(StudyContext& c, const StageSpec& stage) {
   std::vector<double> ratio;
   for (std::uint64_t seed : stage.seeds) {
     if (c.stop()) return;
-    const StudyContext::Fresh fr = c.fresh(d.balls, seed, stage.runs);
+    const StudyContext::Fresh fr = c.fresh(d.choice, seed, stage.runs);
     v.runs = fr.settings.study.runs;
     const opt::Evaluation& be = fr.baseline;
     if (c.stop()) return;
@@ -91,7 +91,7 @@ void run_validate_stage(StudyContext& c, const StageSpec& stage) {
           return s;
         };
         const opt::Evaluation be = c.evaluate_profile(at_point(c.baseline_sample(seed, runs)), c.file.base.setup.profile);
-        const opt::Evaluation de = c.evaluate_profile(at_point(settings_of_choice(c.file, d.balls, be.metrics)), d.profile);
+        const opt::Evaluation de = c.evaluate_profile(at_point(settings_of_choice(c.file, d.choice, be.metrics)), d.profile);
         row.push_back(de.ok && be.ok ? de.metrics.at("ir_magnitude_mean") / be.metrics.at("ir_magnitude_mean") : NAN);
       }
       v.map_ratio.push_back(row);

@@ -157,6 +157,42 @@ TEST(MpiCli, OptimizeOverTwoRanksIsIdenticalToOneProcess) {
   EXPECT_GT(history_without_timing(d2 / "history.csv").size(), 200u);
 }
 
+// `abuopt study` (docs/study.md): every Monte Carlo of the stages (optimisers, replications,
+// validation, the map, the final positions) over the ranks; summary.json identical to one
+// process's. The quick study shrunk to seconds (as tests/app/study_cli_test.py's tiny study).
+TEST(MpiCli, StudyOverTwoRanksIsIdenticalToOneProcess) {
+  REQUIRE_MPI();
+  std::ifstream in(std::string(ABUOPT_SOURCE_DIR) + "/configs/studies/quick.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::pair<std::string, std::string> shrink[] = {
+      {"runs: 64, seed: 21", "runs: 8, seed: 21"},
+      {"{algorithm: direct_l, max_evaluations: 30}", "{algorithm: direct_l, max_evaluations: 4}"},
+      {"max_evaluations: 30, initial_step: 0.1", "max_evaluations: 4, initial_step: 0.1"},
+      {"seeds: [101, 102, 103], runs: 64", "seeds: [101], runs: 8"},
+      {"seeds: [9001, 9002, 9003, 9004]\n    runs: 256", "seeds: [9001, 9002]\n    runs: 8"},
+      {"map: {friction_mu: [0.02, 0.03, 0.04], imbalance_mass_factor: [0.8, 1, 1.2], runs: 64}",
+       "map: {friction_mu: [0.03], imbalance_mass_factor: [0.8, 1.2], runs: 8}"}};
+  for (const auto& [from, to] : shrink) {
+    const auto at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << "configs/studies/quick.yaml lacks: " << from;
+    text.replace(at, from.size(), to);
+  }
+  const fs::path dir = fresh_dir("study");
+  fs::create_directories(dir);
+  const fs::path study = dir / "tiny.yaml";
+  std::ofstream(study) << text;
+  const fs::path d1 = dir / "one", d2 = dir / "two";
+  const Shell one = shell(plain("study " + study.string() + " --out " + d1.string() + " --threads 1"));
+  ASSERT_TRUE(one.status == 0 || one.status == 3) << one.output;  // 3: no design recommended (a valid end)
+  const Shell two = shell(mpirun(2, "study " + study.string() + " --out " + d2.string() + " --threads 1"));
+  ASSERT_EQ(two.status, one.status) << two.output;
+  EXPECT_NE(two.output.find("every Monte Carlo over 2 MPI ranks"), std::string::npos) << two.output;
+  const nlohmann::json s1 = read_json(d1 / "summary.json"), s2 = read_json(d2 / "summary.json");
+  EXPECT_EQ(strip(s1), strip(s2));
+  EXPECT_GT(s1.at("evaluations").get<long>(), 4);
+  EXPECT_TRUE(s1.contains("validation")) << s1.dump(1).substr(0, 2000);
+}
+
 TEST(MpiCli, ReproduceOverTwoRanksIsIdenticalToOneProcess) {
   REQUIRE_MPI();
   const fs::path d1 = fresh_dir("rep1"), d2 = fresh_dir("rep2");

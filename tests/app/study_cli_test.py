@@ -8,10 +8,25 @@
   study_cli_test.py ABUOPT browser  the tiny study's report.html in headless Chromium: no console
                                     error, every inline figure rendered with a non-zero size
                                     (exit 77 = skipped when chromium is not installed)
+  study_cli_test.py ABUOPT pareto   the tiny study with a pareto stage (two bounds on the startup time,
+                                    its points on fresh samples): every bound's point in summary.json,
+                                    report.md and report.html, T within each bound, the front's mean |I_r|
+                                    not rising as the bound loosens, designs/pareto_T<bound>.yaml, a rerun
+                                    from the archive with the same front
+  study_cli_test.py ABUOPT choices  the tiny study with the ball count a variable of the global stage
+                                    (2-4 balls at one total mass: the chosen count polished, how every count
+                                    did, the design file with those balls, a rerun from the archive) and
+                                    with two ball sets (each optimised, the winner named); bad choices
+                                    exit 2 naming the key
+  study_cli_test.py ABUOPT check    every study file under configs/studies/ (a YAML file with `stages:`
+                                    and `family:`, so files added later are checked too) passes
+                                    `--check` (exit 0, the plan printed, nothing written); bad files fail
+                                    with exit 2 naming the key
   study_cli_test.py ABUOPT quick    configs/studies/quick.yaml end to end (<= 2 min on 2 cores), killed
                                     with SIGKILL part way and resumed, and interrupted with SIGINT and
                                     resumed: the same summary as a run that was never interrupted
 """
+import glob
 import json
 import os
 import re
@@ -88,8 +103,21 @@ def check_outputs(out, summary):
         fail("report.html refers to the network")
     if html.count("<svg") < 2:
         fail(f"report.html has {html.count('<svg')} figures")
-    if summary["recommended"] is not None and "Recommended design" not in html.split("<h2>")[0]:
-        fail("the answer is not the first thing in report.html")
+    # the headline says what the study can say: "Recommended" only for a design that held up on fresh
+    # samples and beat the baseline there; the answer comes first
+    headline = {"recommended": "Recommended design", "candidate": "Candidate design", "no_better": "Best design found",
+                "worse": "Best design found", "unvalidated": "Best design found", "none": "No design is recommended"}
+    first = html.split("<h2>")[0]
+    if headline[summary["verdict"]] not in first:
+        fail(f"verdict {summary['verdict']}: the headline is not the first thing in report.html")
+    if summary["verdict"] != "recommended" and "Recommended design" in html:
+        fail(f"verdict {summary['verdict']} but the report says 'Recommended design'")
+    ratio = summary.get("validation", {}).get("ratio_mean_abs_ir")
+    if summary["verdict"] == "recommended" and not (ratio and ratio["hi95"] < 1):
+        fail("recommended without a validation better than the baseline")
+    md = open(os.path.join(out, "report.md")).read()
+    if headline[summary["verdict"]] not in md.split("## ")[1]:
+        fail("report.md's answer and report.html's disagree")
 
 
 def mode_tiny():
@@ -187,7 +215,8 @@ def mode_browser():
         console = [l for l in p.stderr.splitlines() if ":CONSOLE" in l]
         if console:
             fail("console messages:\n" + "\n".join(console))
-        if "Recommended design" not in p.stdout and "No design is recommended" not in p.stdout:
+        if not any(h in p.stdout for h in ("Recommended design", "Candidate design", "Best design found",
+                                           "No design is recommended")):
             fail("Chromium's DOM lacks the answer:\n" + p.stdout[:2000])
         # 2. a copy with a check script: every figure laid out with a non-zero size
         checked = os.path.join(out, "report_check.html")
@@ -256,4 +285,235 @@ def mode_quick():
         shutil.rmtree(tmp, ignore_errors=True)
 
 
-{"tiny": mode_tiny, "browser": mode_browser, "quick": mode_quick}[MODE]()
+def mode_pareto():
+    tmp = tempfile.mkdtemp(prefix="abuopt_study_pareto_")
+    try:
+        text = open(tiny_study(tmp)).read()
+        stage = ("  - {kind: pareto, bounds: [12, 7.5], optimizer: {algorithm: cobyla, max_evaluations: 4, "
+                 "initial_step: 0.1}, seeds: [101, 102], runs: 4}\n")
+        text = text.replace("  - kind: validate", stage + "  - kind: validate")
+        # 4 runs: the peak amplitude against the baseline's is noise; the front is about T
+        text = text.replace("amplitude_vs_baseline: 1.0", "amplitude_vs_baseline: 3.0")
+        study = os.path.join(tmp, "pareto.yaml")
+        open(study, "w").write(text)
+        out = os.path.join(tmp, "p")
+        run(["study", study, "--out", out, "--threads", "1"])
+        s = json.load(open(os.path.join(out, "summary.json")))
+        front = s.get("pareto")
+        if not front or [p["bound_s"] for p in front["points"]] != [7.5, 12]:
+            fail(f"summary.json pareto: {front}")
+        feasible = [p for p in front["points"] if p["feasible"]]
+        if not feasible:
+            fail("no feasible front point (a 12 s bound is loose for this family)")
+        for p in front["points"]:
+            if p["label"] != "pareto_T" + ("7p5" if p["bound_s"] == 7.5 else "12"):
+                fail(f"label {p['label']}")
+            if not os.path.exists(os.path.join(out, p["file"])):
+                fail(f"{p['file']} missing")
+            if p["feasible"] and p["startup_time_s"] > p["bound_s"] * (1 + 1e-9):
+                fail(f"T = {p['startup_time_s']} over the bound {p['bound_s']}")
+            if p["out_of_sample_mean_abs_ir"]["samples"] != 2:
+                fail(f"out of sample: {p['out_of_sample_mean_abs_ir']}")
+            if not (p["evaluations"] <= 4):
+                fail(f"evaluations {p['evaluations']} over the stage's 4")
+        for a, b in zip(feasible, feasible[1:]):  # a looser bound can only do as well or better
+            if b["in_sample"]["metrics"]["ir_magnitude_mean"] > a["in_sample"]["metrics"]["ir_magnitude_mean"] + 1e-12:
+                fail(f"the front rises: {a} then {b}")
+        if front["baseline_out_of_sample_mean_abs_ir"]["samples"] != 2:
+            fail("the baseline out of sample")
+        html = open(os.path.join(out, "report.html")).read()
+        md = open(os.path.join(out, "report.md")).read()
+        if "Pareto front" not in html or "Pareto front" not in md or "pareto_T7p5.yaml" not in md:
+            fail("the front is not in the report")
+        if html.count("<svg") < 4:
+            fail("no front figure")
+        # the design of a front point runs with abuopt montecarlo
+        dtext = open(os.path.join(out, "designs", "pareto_T12.yaml")).read().replace("runs: 4\n", "runs: 2\n")
+        small = os.path.join(tmp, "front_small.yaml")
+        open(small, "w").write(dtext)
+        run(["montecarlo", small, "--out", os.path.join(tmp, "mc")])
+        # a rerun: everything from the archive, the same front
+        run(["study", study, "--out", out, "--threads", "1"])
+        s2 = json.load(open(os.path.join(out, "summary.json")))
+        if s2["archive_hits"] != s2["evaluations"] or comparable(s2) != comparable(s):
+            fail("a rerun from the archive changed the front or computed again")
+        # bad pareto stages: exit 2 naming the key
+        for old, new, want in [("bounds: [12, 7.5]", "bounds: [12, -1]", "stages[3].bounds"),
+                               ("bounds: [12, 7.5]", "bounds: [12, 12]", "each bound may appear once"),
+                               ("{kind: pareto, bounds", "{kind: pareto, over: amplitude, bounds", "stages[3].over = amplitude")]:
+            bad = os.path.join(tmp, "bad.yaml")
+            open(bad, "w").write(text.replace(old, new))
+            p = run(["study", bad, "--check"], expect=2)
+            if want not in p.stderr:
+                fail(f"bad pareto stage ({new}): {p.stderr}")
+        print(f"ok: pareto stage: {len(front['points'])} bounds, {len(feasible)} feasible, in and out of sample, "
+              "rerun from the archive")
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def yaml_balls(path):
+    """The balls of a design file's abu section: [(mass_kg, diameter_m), ...]."""
+    return [(float(m), float(d)) for m, d in re.findall(r"- \{mass_kg: ([0-9.e+-]+), diameter_m: ([0-9.e+-]+)\}",
+                                                         open(path).read())]
+
+
+def mode_choices():
+    tmp = tempfile.mkdtemp(prefix="abuopt_study_choices_")
+    try:
+        base = open(tiny_study(tmp)).read()
+        # 1. the ball count a variable of the global stage (DIRECT_L: 20 evaluations reach every count)
+        text = base.replace("stages:", "choices:\n  balls: {counts: [2, 3, 4], total_mass_kg: 2.8e-4, mode: variable}\nstages:")
+        text = text.replace("{algorithm: direct_l, max_evaluations: 3}", "{algorithm: direct_l, max_evaluations: 20}")
+        study = os.path.join(tmp, "variable.yaml")
+        open(study, "w").write(text)
+        p = run(["study", study, "--check"])
+        if "balls in [1.5, 4.5] (rounded to the nearest count)" not in p.stdout:
+            fail("--check of the variable count:\n" + p.stdout)
+        out = os.path.join(tmp, "v")
+        run(["study", study, "--out", out, "--threads", "1"])
+        s = json.load(open(os.path.join(out, "summary.json")))
+        if not s["ball_count_variable"] or [c["label"] for c in s["choices"]] != ["balls2", "balls3", "balls4"]:
+            fail(f"choices: {s['choices']}")
+        glob_trace = s["traces"][0]
+        if glob_trace["choice"] != "variable count" or glob_trace["balls"] != 0:
+            fail(f"the global stage's trace: {glob_trace}")
+        counted = sum(c["evaluations"] for c in s["choices"])
+        if counted != glob_trace["evaluations"] or sum(1 for c in s["choices"] if c["evaluations"] > 0) < 2:
+            fail(f"evaluations per count {[c['evaluations'] for c in s['choices']]} vs the stage's {glob_trace['evaluations']}")
+        chosen = [c for c in s["choices"] if c["chosen"]]
+        if len(chosen) != 1:
+            fail(f"chosen: {chosen}")
+        n = len(chosen[0]["balls"])
+        best = [c["best_feasible_objective"] for c in s["choices"] if c["best_feasible_objective"] is not None]
+        if chosen[0]["best_feasible_objective"] is not None and chosen[0]["best_feasible_objective"] != min(best):
+            fail("the chosen count is not the best one")
+        for d in s["designs"]:  # the global stage's best and the polish: the chosen count
+            if d["balls"] != n:
+                fail(f"design {d['label']} has {d['balls']} balls, the chosen count is {n}")
+            balls = yaml_balls(os.path.join(out, d["file"]))
+            if len(balls) != n or any(abs(m - 2.8e-4 / n) > 1e-15 for m, _ in balls):
+                fail(f"{d['file']}: balls {balls}, expected {n} of {2.8e-4 / n} kg")
+        md = open(os.path.join(out, "report.md")).read()
+        if "## Ball choices" not in md or f"they chose {n} balls" not in md:
+            fail("report.md does not say which count was chosen:\n" + md[:3000])
+        if "Ball choices" not in open(os.path.join(out, "report.html")).read():
+            fail("report.html has no ball choices")
+        run(["study", study, "--out", out, "--threads", "1"])
+        s2 = json.load(open(os.path.join(out, "summary.json")))
+        if s2["archive_hits"] != s2["evaluations"] or comparable(s2) != comparable(s):
+            fail("a rerun of the variable-count study changed the results or computed again")
+
+        # 2. two ball sets, each optimised; the abu section's ball keys
+        sets = ("choices:\n  balls:\n    sets:\n"
+                "      - {name: two_heavy, ball_count: 2, ball_mass_kg: 1.4e-4, ball_diameter_m: 3e-3}\n"
+                "      - {balls: [{mass_kg: 1e-4, diameter_m: 2.5e-3}, {mass_kg: 1e-4, diameter_m: 2.5e-3}, "
+                "{mass_kg: 8e-5, diameter_m: 2.5e-3}]}\nstages:")
+        text = base.replace("stages:", sets)
+        study = os.path.join(tmp, "sets.yaml")
+        open(study, "w").write(text)
+        out = os.path.join(tmp, "s")
+        run(["study", study, "--out", out, "--threads", "1"])
+        s = json.load(open(os.path.join(out, "summary.json")))
+        if [c["label"] for c in s["choices"]] != ["two_heavy", "set2"] or s["ball_count_variable"]:
+            fail(f"sets: {s['choices']}")
+        labels = [d["label"] for d in s["designs"]]
+        for want in ("two_heavy_global", "two_heavy_local", "set2_global", "set2_local"):
+            if want not in labels:
+                fail(f"{want} not among {labels}")
+        balls = yaml_balls(os.path.join(out, "designs", "set2_local.yaml"))
+        if balls != [(1e-4, 2.5e-3), (1e-4, 2.5e-3), (8e-5, 2.5e-3)]:
+            fail(f"set2's design file has balls {balls}")
+        if "## Ball choices" not in open(os.path.join(out, "report.md")).read():
+            fail("no ball choices in report.md")
+
+        # 3. bad choices: exit 2, the key named
+        for old, new, want in [
+                ("balls: {counts: [2, 3, 4], total_mass_kg: 2.8e-4, mode: variable}",
+                 "balls: {counts: [2, 4], total_mass_kg: 2.8e-4, mode: variable}", "choices.balls.mode = variable"),
+                ("balls: {counts: [2, 3, 4], total_mass_kg: 2.8e-4, mode: variable}",
+                 "balls: {counts: [2, 3], mode: sometimes}", "choices.balls.mode = sometimes"),
+                ("ball_diameter_m: 3e-3}", "ball_diameter_m: 0.02}", "choices.balls.sets[0].balls[0].diameter_m"),
+                ("{name: two_heavy, ball_count: 2,", "{name: two_heavy, ball_count: 2, balls: [], ",
+                 "choices.balls.sets[0].ball_count")]:
+            src = open(os.path.join(tmp, "variable.yaml" if "counts" in old else "sets.yaml")).read()
+            assert old in src, old
+            bad = os.path.join(tmp, "bad.yaml")
+            open(bad, "w").write(src.replace(old, new))
+            p = run(["study", bad, "--check"], expect=2)
+            if want not in p.stderr:
+                fail(f"bad choices ({new}): {p.stderr}")
+        src = open(os.path.join(tmp, "variable.yaml")).read()
+        i, j = src.index("  - {kind: global"), src.index("  - {kind: local")
+        bad = src[:i] + src[j:]  # no global stage: nothing would choose the count
+        open(os.path.join(tmp, "bad.yaml"), "w").write(bad)
+        p = run(["study", os.path.join(tmp, "bad.yaml"), "--check"], expect=2)
+        if "first optimiser stage must be global" not in p.stderr:
+            fail("a variable count without a global stage: " + p.stderr)
+        print(f"ok: the ball count a variable ({n} balls chosen; evaluations per count "
+              f"{[c['evaluations'] for c in json.load(open(os.path.join(tmp, 'v', 'summary.json')))['choices']]}), "
+              "two ball sets, bad choices named")
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def study_files():
+    """Every `abuopt study` file under configs/studies/ (the `abuopt optimize` configs there have no `stages:`)."""
+    out = []
+    for path in sorted(glob.glob(os.path.join("configs", "studies", "**", "*.yaml"), recursive=True)):
+        text = open(path).read()
+        if re.search(r"^stages:", text, re.M) and re.search(r"^family:", text, re.M):
+            out.append(path)
+    return out
+
+
+def mode_check():
+    files = study_files()
+    if QUICK not in files:
+        fail(f"the glob found {files}, not {QUICK}")
+    tmp = tempfile.mkdtemp(prefix="abuopt_study_check_")
+    try:
+        for path in files:
+            t0 = time.time()
+            p = run(["study", path, "--check", "--out", os.path.join(tmp, "never")])
+            for want in ("the file is valid", "natural frequency f_n", "free variables", "stages:", "budget:",
+                         "estimate: at most"):
+                if want not in p.stdout:
+                    fail(f"--check of {path} lacks '{want}':\n{p.stdout}")
+            if os.path.exists(os.path.join(tmp, "never")):
+                fail(f"--check of {path} wrote its output directory")
+            if time.time() - t0 > 10:
+                fail(f"--check of {path} took {time.time() - t0:.1f} s: it must not simulate")
+        # the quick study's plan: f_n of the report's ABU, bounds converted to Hz, the estimate
+        p = run(["study", QUICK, "--check"])
+        if "f_n = sqrt(k/M)/2pi = 28.89 Hz" not in p.stdout or "f2 in [28.019, 31.774] Hz" not in p.stdout:
+            fail("the quick study's plan:\n" + p.stdout)
+        # 64 runs x (1 baseline + 60 optimiser evaluations) + 3 x 2 x 64 + 2 x 4 x 256 + 2 x 9 x 64 + 2 x 256
+        if "estimate: at most 8,000 simulations" not in p.stdout:
+            fail("the quick study's estimate:\n" + p.stdout)
+        # bounds in Hz that cannot reach f_n: a warning, still exit 0
+        hz = os.path.join(tmp, "hz.yaml")
+        open(hz, "w").write(open(QUICK).read().replace("frequency_unit: natural", "frequency_unit: hz"))
+        p = run(["study", hz, "--check"])
+        if "warning: 2 balls: the family cannot reach the resonance" not in p.stdout:
+            fail("no resonance warning:\n" + p.stdout)
+        # bad files: exit 2, the key, the value and the rule named, as a run says it
+        for old, new, want in [
+                ("kind: validate", "kind: check", "stages[3].kind = check"),
+                ("runs: 64, seed: 21", "runs: -3, seed: 21", "runs = -3"),
+                ("algorithm: direct_l", "algorithm: nosuch", "nosuch"),
+                ("max_pct_mi: 100", "max_pct_mi: 100\n  max_speed: 3", "constraints.max_speed")]:
+            bad = os.path.join(tmp, "bad.yaml")
+            text = open(QUICK).read()
+            assert old in text, old
+            open(bad, "w").write(text.replace(old, new, 1))
+            p = run(["study", bad, "--check"], expect=2)
+            if want not in p.stderr:
+                fail(f"bad file ({new}): the message does not name '{want}':\n{p.stderr}")
+        print(f"ok: --check passes {len(files)} study files ({', '.join(files)}); bad files exit 2 naming the key")
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+{"tiny": mode_tiny, "browser": mode_browser, "quick": mode_quick, "check": mode_check, "pareto": mode_pareto,
+ "choices": mode_choices}[MODE]()

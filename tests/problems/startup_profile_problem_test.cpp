@@ -658,3 +658,79 @@ TEST(StartupProfileProblem, SampledValueIsTheSmallerStudy) {
   EXPECT_THROW(grid.evaluate_sampled(x, 2), std::invalid_argument);
   EXPECT_EQ(grid.evaluate_sampled(x, 4).objective, grid.evaluate(x).objective);
 }
+
+// design.ball_count: the count as one more (rounded) variable; each count evaluates exactly as a
+// problem whose abu has those balls (mass total / n, the diameter of a steel sphere of that mass).
+TEST(StartupProfileProblem, BallCountVariableIsTheRoundedCountAtTheTotalMass) {
+  const std::string mc = "montecarlo: {design: lhs, runs: 6, seed: 4, threads: 1}\n";
+  const std::string seg = "design:\n  segments:\n    - end_frequency_hz: {min: 20, max: 40, x0: 35}\n"
+                          "      duration_s: 0.4\n";
+  StartupProfileProblem p(settings_from(mc + seg + "  ball_count: {min: 2, max: 5, x0: 3, total_mass_kg: 2.4e-4}\n"));
+  const auto vars = p.variables();
+  ASSERT_EQ(vars.size(), 2u);
+  EXPECT_EQ(vars[1].name, "balls");
+  EXPECT_DOUBLE_EQ(vars[1].lower, 1.5);  // every count an interval of width 1
+  EXPECT_DOUBLE_EQ(vars[1].upper, 5.5);
+  EXPECT_EQ(p.initial_point(), (std::vector<double>{35, 3}));
+  EXPECT_EQ(p.ball_count_variable(), std::optional<std::size_t>(1));
+  EXPECT_EQ(p.balls_at({35, 1.5}), 2u);
+  EXPECT_EQ(p.balls_at({35, 3.49}), 3u);
+  EXPECT_EQ(p.balls_at({35, 3.5}), 4u);
+  EXPECT_EQ(p.balls_at({35, 5.5}), 5u);  // the upper end clamps
+  const AbuParameters abu = p.abu_at({35, 4.2});
+  ASSERT_EQ(abu.balls.size(), 4u);
+  EXPECT_DOUBLE_EQ(abu.balls[0].mass_kg, 6e-5);
+  // steel (7850 kg/m^3): d = cbrt(6 m / (pi rho)) = 2.4440 mm for 6e-5 kg
+  EXPECT_NEAR(abu.balls[3].diameter_m, std::cbrt(6 * 6e-5 / (M_PI * 7850)), 1e-15);
+  EXPECT_NEAR(abu.balls[3].diameter_m, 2.4440e-3, 1e-7);
+
+  // x = (35, 3.8): exactly the problem of a 4-ball abu with that profile
+  const opt::Evaluation e = p.evaluate({35, 3.8});
+  ASSERT_TRUE(e.ok) << e.message;
+  EXPECT_EQ(e.metrics.at("balls"), 4);
+  StartupProfileSettings four = settings_from(mc + seg);
+  four.study.setup.abu = abu_with_ball_count(four.study.setup.abu, 4, p.settings().design.ball_count);
+  const MonteCarloStats st = direct_stats(four, StartupProfile({{35, 0.4}}));
+  EXPECT_DOUBLE_EQ(e.objective, st.magnitude.mean / 1e-7);
+  // another count is another Monte Carlo (other masses, other initial angles)
+  const opt::Evaluation two = p.evaluate({35, 2});
+  ASSERT_TRUE(two.ok);
+  EXPECT_EQ(two.metrics.at("balls"), 2);
+  EXPECT_NE(two.objective, e.objective);
+  // out of sample: the balls at x too
+  EXPECT_EQ(p.evaluate_out_of_sample_at({35, 3.8}).metrics.at("balls"), 4);
+
+  // a given diameter replaces the density; identity: the mass and diameter are in it, the bounds are not
+  StartupProfileProblem d(settings_from(mc + seg + "  ball_count: {min: 2, max: 5, total_mass_kg: 2.4e-4, diameter_m: 0.003}\n"));
+  EXPECT_DOUBLE_EQ(d.abu_at({35, 2}).balls[1].diameter_m, 0.003);
+  EXPECT_DOUBLE_EQ(d.initial_point()[1], 2);  // x0 defaults to min
+  EXPECT_NE(d.identity(), p.identity());
+  StartupProfileProblem wider(settings_from(mc + seg + "  ball_count: {min: 1, max: 6, x0: 3, total_mass_kg: 2.4e-4}\n"));
+  EXPECT_EQ(wider.identity(), p.identity());
+  StartupProfileProblem heavier(settings_from(mc + seg + "  ball_count: {min: 2, max: 5, x0: 3, total_mass_kg: 3e-4}\n"));
+  EXPECT_NE(heavier.identity(), p.identity());
+  // without ball_count the identity is what it was (archives of older problems still answer)
+  EXPECT_EQ(StartupProfileProblem(settings_from(mc + seg)).identity_text().find("ball_count"), std::string::npos);
+}
+
+TEST(StartupProfileProblem, BallCountErrorsNameKeyValueAndRule) {
+  const std::string lhs = "montecarlo: {design: lhs, runs: 6, seed: 4, threads: 1}\n";
+  const std::string seg = "design:\n  segments:\n    - end_frequency_hz: {min: 20, max: 40, x0: 35}\n"
+                          "      duration_s: 0.4\n  ball_count: ";
+  const auto err = [&](const std::string& bc, const std::string& m = "") {
+    return error_of([&] { StartupProfileProblem p(settings_from((m.empty() ? lhs : m) + seg + bc + "\n")); });
+  };
+  EXPECT_NE(err("{min: 2.5, max: 5, total_mass_kg: 2e-4}").find("design.ball_count.min = 2.5: must be a whole number"),
+            std::string::npos) << err("{min: 2.5, max: 5, total_mass_kg: 2e-4}");
+  EXPECT_NE(err("{min: 4, max: 3, total_mass_kg: 2e-4}").find("design.ball_count.min = 4: must be below"), std::string::npos);
+  EXPECT_NE(err("{min: 2, max: 4, x0: 5, total_mass_kg: 2e-4}").find("design.ball_count.x0 = 5"), std::string::npos);
+  EXPECT_NE(err("{min: 2, max: 4}").find("design.ball_count.total_mass_kg"), std::string::npos);
+  EXPECT_NE(err("{min: 2, max: 13, total_mass_kg: 2e-4}").find("design.ball_count.max = 13"), std::string::npos);
+  EXPECT_NE(err("{min: 2, max: 4, total_mass_kg: 2e-4, diameter_m: 0.003, density_kg_m3: 7000}")
+                .find("design.ball_count.density_kg_m3"), std::string::npos);
+  EXPECT_NE(err("{min: 2, max: 4, total_mass_kg: 2e-4}", "montecarlo: {design: grid, grid: 2, threads: 1}\n")
+                .find("montecarlo.design = grid: cannot be used with design.ball_count"), std::string::npos);
+  // twelve balls of 3 cm do not fit on the report's 11.5 mm track
+  const std::string big = err("{min: 2, max: 12, total_mass_kg: 2e-4, diameter_m: 0.03}");
+  EXPECT_NE(big.find("design.ball_count: with"), std::string::npos) << big;
+}

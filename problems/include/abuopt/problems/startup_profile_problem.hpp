@@ -85,10 +85,33 @@ struct SegmentDesign {
   DesignValue duration_s;        // variable name dt<i>
 };
 
+// The ball count as one more design variable (design.ball_count, docs/optimize.md): identical
+// balls sharing a fixed total mass, m = total_mass_kg / n each. The optimiser sees a continuous
+// variable `balls` in [min - 0.5, max + 0.5]; the count is the nearest whole number (clamped to
+// [min, max]), so every count has an interval of width 1. A ball's diameter is diameter_m when given,
+// else that of a solid sphere of the mass and density_kg_m3 (steel by default): d = cbrt(6 m / (pi rho)).
+// Each count has its own initial angles (a design over n balls), the same for every design.
+inline constexpr double kMaxBallCount = 12;
+struct BallCountDesign {
+  bool free = false;              // the design.ball_count section is given
+  double lower = 0.0, upper = 0.0;  // whole counts, 1 <= min < max <= kMaxBallCount
+  double value = 0.0;             // x0, a whole count in [min, max] (default min)
+  double total_mass_kg = 0.0;     // > 0
+  double density_kg_m3 = 7850.0;  // steel
+  std::optional<double> diameter_m;  // every ball this diameter (then the density is not used)
+};
+
 struct ProfileDesign {
   double start_frequency_hz = 0.0;
   std::vector<SegmentDesign> segments;
+  BallCountDesign ball_count;
 };
+
+// The count the ball-count variable x stands for: the nearest whole number, clamped to [min, max].
+std::size_t ball_count_at(const BallCountDesign& b, double x);
+// The ABU with n identical balls of the ball-count design (mass total / n, its diameter); the
+// other parameters as given.
+AbuParameters abu_with_ball_count(const AbuParameters& abu, std::size_t n, const BallCountDesign& b);
 
 enum class ObjectiveKind { Mean, PctMi, Weighted, SmoothPctMi, Quantile, Cvar, StartupTime };
 enum class ImbalanceDefinition { Magnitude, ReportX };
@@ -224,6 +247,12 @@ class StartupProfileProblem : public opt::Problem {
   StartupProfile profile_at(const std::vector<double>& x) const;
   // Sum of the durations at x [s].
   double startup_time_s(const std::vector<double>& x) const;
+  // The ball count at x (design.ball_count: the variable `balls`, rounded; otherwise the abu's).
+  std::size_t balls_at(const std::vector<double>& x) const;
+  // The ABU evaluated at x (the abu section, with design.ball_count's balls at x when given).
+  AbuParameters abu_at(const std::vector<double>& x) const;
+  // Index of the variable `balls` (design.ball_count given), or none.
+  std::optional<std::size_t> ball_count_variable() const { return ball_variable_; }
 
   // Evaluates any profile exactly as evaluate() does, on the in-sample initial conditions, or on
   // another set (design kind/grid/count/seed; `seed` also seeds the uncertain parameters).
@@ -232,6 +261,8 @@ class StartupProfileProblem : public opt::Problem {
                                    std::size_t runs, std::uint64_t seed) const;
   // The validation set of the settings as (design, runs, seed) for evaluate_profile.
   opt::Evaluation evaluate_out_of_sample(const StartupProfile& profile) const;
+  // The design x (its profile and, with design.ball_count, its balls) on the validation set.
+  opt::Evaluation evaluate_out_of_sample_at(const std::vector<double>& x) const;
 
   // Everything that decides the value of evaluate(x) as canonical text, derived from the field
   // lists (identity_fields of the settings): every key of abu, profile, motor, simulation, the
@@ -256,11 +287,14 @@ class StartupProfileProblem : public opt::Problem {
   };
   std::vector<Slot> slots_;
   std::vector<std::string> constraint_names_;
+  std::optional<std::size_t> ball_variable_;  // index of `balls` in x
   std::shared_ptr<BatchRunner> runner_;
   bool runner_concurrent_ = false;
 
+  // balls = 0: the abu as given; otherwise abu_with_ball_count(balls).
   opt::Evaluation evaluate_with_threads(const StartupProfile& profile, const InitialConditionDesign& design,
-                                        std::size_t runs, std::uint64_t seed, std::size_t threads) const;
+                                        std::size_t runs, std::uint64_t seed, std::size_t threads,
+                                        std::size_t balls = 0) const;
 };
 
 }  // namespace abuopt::problems
