@@ -138,7 +138,7 @@ def main():
              "value is within 1 % / 2 % of f* (median over all runs, a run that never got there counting as infinite; in brackets how many got there).\n",
              "Reproduce (measured: 37 min for the suite with Optuna's runs beside it and 3.5 min for the benchmarks, on 2 cores shared with other jobs; Optuna's runs "
              "first, compare reads them as solvers with `external:`):\n\n"
-             "    for s in tpe cmaes; do for p in two_ball_19s two_ball_envelope; do\n"
+             "    for s in tpe cmaes; do for p in two_ball_19s two_ball_envelope ball_count_19s; do\n"
              "      python3 examples/python/optuna_study.py configs/compare/adopt_suite.yaml --problem $p "
              "--sampler $s --out results/optuna-$s; done; done\n"
              "    abuopt compare configs/compare/adopt_suite.yaml --out results/adopt_suite\n"

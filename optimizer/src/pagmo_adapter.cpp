@@ -26,41 +26,28 @@
 
 #include <algorithm>
 #include <cmath>
-#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "abuopt/common/config_error.hpp"
 #include "adapters.hpp"
+#include "pagmo_common.hpp"
 
 namespace abuopt::opt::detail {
 
 namespace {
 
-constexpr double kInfeasible = 1e30;
-constexpr double kFailed = 1e300;
-
-// Thrown through pagmo when the driver stops the run (budget, time, target, interrupt, error).
-struct RunStopped {};
+using namespace pagmo_common;
 
 struct PagmoContext {
   EvaluationDriver* driver = nullptr;
   double constraint_tolerance = 0.0;
 };
 
-std::vector<double> to_scaled(const EvaluationDriver& d, const pagmo::vector_double& u) {
-  std::vector<double> y(d.n());
-  for (std::size_t i = 0; i < d.n(); ++i) {
-    const double ui = std::min(std::max(u[i], 0.0), 1.0);
-    y[i] = d.lower_scaled()[i] + ui * (d.upper_scaled()[i] - d.lower_scaled()[i]);
-  }
-  return y;
-}
-
 double fitness_value(const EvaluatedPoint& p, double tolerance) {
   if (!p.e.ok || !std::isfinite(p.e.objective)) return kFailed;
-  if (p.violation > tolerance) return kInfeasible * (1.0 + std::min(p.violation, 1e250));
+  if (p.violation > tolerance) return infeasible_fitness(p.violation);
   return p.e.objective;
 }
 
@@ -70,7 +57,7 @@ struct DriverUdp {
   std::size_t n = 0;
 
   pagmo::vector_double fitness(const pagmo::vector_double& u) const {
-    const EvaluatedPoint* p = ctx->driver->evaluate(to_scaled(*ctx->driver, u).data());
+    const EvaluatedPoint* p = ctx->driver->evaluate(to_scaled(*ctx->driver, u.data()).data());
     if (!p) throw RunStopped{};
     return {fitness_value(*p, ctx->constraint_tolerance)};
   }
@@ -79,9 +66,7 @@ struct DriverUdp {
     const std::size_t k = dvs.size() / n;
     std::vector<std::vector<double>> ys;
     ys.reserve(k);
-    for (std::size_t i = 0; i < k; ++i)
-      ys.push_back(to_scaled(*ctx->driver, pagmo::vector_double(dvs.begin() + static_cast<long>(i * n),
-                                                               dvs.begin() + static_cast<long>((i + 1) * n))));
+    for (std::size_t i = 0; i < k; ++i) ys.push_back(to_scaled(*ctx->driver, dvs.data() + i * n));
     const std::vector<const EvaluatedPoint*> ps = ctx->driver->evaluate_batch(ys);
     pagmo::vector_double f(k);
     for (std::size_t i = 0; i < k; ++i) {
@@ -90,9 +75,7 @@ struct DriverUdp {
     }
     return f;
   }
-  std::pair<pagmo::vector_double, pagmo::vector_double> get_bounds() const {
-    return {pagmo::vector_double(n, 0.0), pagmo::vector_double(n, 1.0)};
-  }
+  std::pair<pagmo::vector_double, pagmo::vector_double> get_bounds() const { return unit_bounds(n); }
   std::string get_name() const { return "abuopt problem"; }
 };
 
@@ -150,34 +133,15 @@ AdapterOutcome run_pagmo(EvaluationDriver& d, const AlgorithmInfo& algorithm, co
   AdapterOutcome out;
   out.algorithm_label = algorithm.name;
 
-  // The initial population: x0 and size-1 seeded uniform points of the unit box, one batch.
-  std::vector<pagmo::vector_double> us;
-  {
-    const std::vector<double> y0 = d.to_scaled(x0);
-    pagmo::vector_double u0(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const double range = d.upper_scaled()[i] - d.lower_scaled()[i];
-      u0[i] = std::min(std::max((y0[i] - d.lower_scaled()[i]) / range, 0.0), 1.0);
-    }
-    us.push_back(u0);
-    std::mt19937_64 rng(options.seed ^ 0x9e3779b97f4a7c15ULL);
-    std::uniform_real_distribution<double> uniform(0.0, 1.0);
-    while (us.size() < size) {
-      pagmo::vector_double u(n);
-      for (double& v : u) v = uniform(rng);
-      us.push_back(std::move(u));
-    }
-  }
   try {
-    pagmo::vector_double flat;
-    for (const auto& u : us) flat.insert(flat.end(), u.begin(), u.end());
+    // the initial population: x0 and size - 1 seeded uniform points of the unit box, one batch
+    const std::vector<double> flat = initial_population(d, x0, size, options.seed);
     const pagmo::vector_double f = prob.extract<DriverUdp>()->batch_fitness(flat);
     pagmo::population pop(prob, 0u, seed32(options.seed) + 1u);
-    for (std::size_t i = 0; i < us.size(); ++i) pop.push_back(us[i], {f[i]});
-
-    // generations: as many as evaluations (repeats of known points are answered from memory and do
-    // not count), so the budget or the algorithm's own tolerances end the run
-    const unsigned generations = static_cast<unsigned>(std::min<long>(options.max_evaluations, 100000000L));
+    for (std::size_t i = 0; i < size; ++i)
+      pop.push_back(pagmo::vector_double(flat.begin() + static_cast<long>(i * n), flat.begin() + static_cast<long>((i + 1) * n)),
+                    {f[i]});
+    const unsigned generations = pagmo_common::generations(options.max_evaluations);
     pagmo::algorithm algo = make_algorithm(algorithm.name, options, generations);
     algo.evolve(pop);
     out.reason = TerminationReason::Converged;

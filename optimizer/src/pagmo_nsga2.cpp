@@ -8,20 +8,18 @@
 
 #include <algorithm>
 #include <cmath>
-#include <random>
+#include <limits>
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/optimizer/multi_objective.hpp"
 #include "evaluation_driver.hpp"
+#include "pagmo_common.hpp"
 
 namespace abuopt::opt {
 
 namespace {
 
-constexpr double kInfeasible = 1e30;
-constexpr double kFailed = 1e300;
-
-struct RunStopped {};
+using namespace detail::pagmo_common;
 
 struct Context {
   detail::EvaluationDriver* driver = nullptr;
@@ -29,21 +27,11 @@ struct Context {
   double tolerance = 0.0;
 };
 
-std::vector<double> scaled(const detail::EvaluationDriver& d, const double* u) {
-  std::vector<double> y(d.n());
-  for (std::size_t i = 0; i < d.n(); ++i)
-    y[i] = d.lower_scaled()[i] + std::min(std::max(u[i], 0.0), 1.0) * (d.upper_scaled()[i] - d.lower_scaled()[i]);
-  return y;
-}
-
 std::pair<double, double> objectives(const detail::EvaluatedPoint& p, const Context& c) {
   const auto m = p.e.metrics.find(c.metric);
   if (!p.e.ok || !std::isfinite(p.e.objective) || m == p.e.metrics.end() || !std::isfinite(m->second))
     return {kFailed, kFailed};
-  if (p.violation > c.tolerance) {
-    const double v = kInfeasible * (1.0 + std::min(p.violation, 1e250));
-    return {v, v};
-  }
+  if (p.violation > c.tolerance) return {infeasible_fitness(p.violation), infeasible_fitness(p.violation)};
   return {p.e.objective, m->second};
 }
 
@@ -54,7 +42,7 @@ struct TwoObjectiveUdp {
   pagmo::vector_double batch_fitness(const pagmo::vector_double& dvs) const {
     const std::size_t k = dvs.size() / n;
     std::vector<std::vector<double>> ys;
-    for (std::size_t i = 0; i < k; ++i) ys.push_back(scaled(*ctx->driver, dvs.data() + i * n));
+    for (std::size_t i = 0; i < k; ++i) ys.push_back(to_scaled(*ctx->driver, dvs.data() + i * n));
     const auto ps = ctx->driver->evaluate_batch(ys);
     pagmo::vector_double f;
     for (const auto* p : ps) {
@@ -66,9 +54,7 @@ struct TwoObjectiveUdp {
     return f;
   }
   pagmo::vector_double::size_type get_nobj() const { return 2; }
-  std::pair<pagmo::vector_double, pagmo::vector_double> get_bounds() const {
-    return {pagmo::vector_double(n, 0.0), pagmo::vector_double(n, 1.0)};
-  }
+  std::pair<pagmo::vector_double, pagmo::vector_double> get_bounds() const { return unit_bounds(n); }
 };
 
 }  // namespace
@@ -127,27 +113,13 @@ TwoObjectiveResult minimize_two_objectives(Problem& problem, const std::string& 
   std::string message = "pagmo: NSGA-II ran its generations";
   try {
     pagmo::problem prob{TwoObjectiveUdp{&ctx, n}};
-    std::vector<double> flat;
-    {
-      const std::vector<double> y0 = driver.to_scaled(x0);
-      for (std::size_t i = 0; i < n; ++i)
-        flat.push_back(std::min(std::max((y0[i] - driver.lower_scaled()[i]) /
-                                             (driver.upper_scaled()[i] - driver.lower_scaled()[i]),
-                                         0.0),
-                                1.0));
-      std::mt19937_64 rng(options.seed ^ 0x9e3779b97f4a7c15ULL);
-      std::uniform_real_distribution<double> uniform(0.0, 1.0);
-      while (flat.size() < static_cast<std::size_t>(size) * n) flat.push_back(uniform(rng));
-    }
+    const std::vector<double> flat = initial_population(driver, x0, static_cast<std::size_t>(size), options.seed);
     const pagmo::vector_double f = prob.extract<TwoObjectiveUdp>()->batch_fitness(flat);
     pagmo::population pop(prob, 0u, static_cast<unsigned>(options.seed) + 1u);
     for (long i = 0; i < size; ++i)
       pop.push_back(pagmo::vector_double(flat.begin() + i * static_cast<long>(n), flat.begin() + (i + 1) * static_cast<long>(n)),
                     {f[2 * i], f[2 * i + 1]});
-    // generations: as many as evaluations (repeats of known points are answered from memory and do
-    // not count), so the budget ends the run
-    const unsigned generations = static_cast<unsigned>(std::min<long>(options.max_evaluations, 100000000L));
-    pagmo::nsga2 nsga(generations, 0.95, 10., 1. / static_cast<double>(std::max<std::size_t>(n, 1)), 20.,
+    pagmo::nsga2 nsga(generations(options.max_evaluations), 0.95, 10., 1. / static_cast<double>(std::max<std::size_t>(n, 1)), 20.,
                       static_cast<unsigned>(options.seed));
     nsga.set_bfe(pagmo::bfe(pagmo::member_bfe{}));
     pagmo::algorithm(std::move(nsga)).evolve(pop);

@@ -73,8 +73,12 @@ void SaoRun::run(const std::vector<double>& x0) {
   if (!c0) return;
   centre_ = *c0;
   centre_z_ = known_[centre_].z;
-  mu_ = sao_.penalty_initial > 0 ? sao_.penalty_initial
-                                 : 10.0 * std::max(1.0, known_[centre_].ok ? std::fabs(known_[centre_].f) : 1.0);
+  // automatic: 10 max(1, |f(x0)|) on a stochastic problem (as measured on the startup problem);
+  // on a deterministic one 1e-3 max(1, |f(x0)|), and the multiplier estimates raise it
+  // (update_penalty): a large mu rejected the steps along hs071's curved equality (the Maratos
+  // effect) and the trust region crept at radii ~1e-3 (docs/sao.md, "Options", penalty_initial)
+  const double f0_scale = std::max(1.0, known_[centre_].ok ? std::fabs(known_[centre_].f) : 1.0);
+  mu_ = sao_.penalty_initial > 0 ? sao_.penalty_initial : (stochastic_ ? 10.0 : 1e-3) * f0_scale;
   if (global_ && !global_phase()) return;
 
   int stalled = 0;
@@ -82,6 +86,28 @@ void SaoRun::run(const std::vector<double>& x0) {
   double streak_radius = radius_;  // the radius before the first of them
   bool polished = false;  // the current trust region has handed over to the polish
   while (true) {
+    // the best objective's gains of the last window are within the noise: the trust region has
+    // converged as far as the noise lets one tell, and after a restart the run (docs/sao.md,
+    // "Stop when the rest is noise")
+    const NoiseStall stall = noise_stall();
+    if (stall != NoiseStall::None) {
+      reason = TerminationReason::ConvergedFtol;
+      message = "the best objective improved by less than " + format_number(sao_.noise_stop) +
+                " noise levels (" + format_number(noise_f_) + ") in " + std::to_string(noise_window()) +
+                " evaluations" + (stall == NoiseStall::Stop ? " after a restart" : "");
+      if (stall == NoiseStall::Stop || !restart_wanted()) return;
+      const long before = driver_.evaluations();
+      const std::optional<bool> restarted = restart();
+      if (!restarted || !*restarted) return;
+      ++restarts_;
+      last_restart_evaluations_ = before;
+      polished = false;
+      message += "; restart " + std::to_string(restarts_);
+      stalled = 0;
+      failures_in_a_row = 0;
+      streak_radius = radius_;
+      continue;
+    }
     if (!polished && (radius_ < kPolishRadius || stalled >= sao_.stall_iterations) && polish_wanted()) {
       if (!polish()) return;
       polished = true;
@@ -104,9 +130,11 @@ void SaoRun::run(const std::vector<double>& x0) {
       // converged with budget left: infill points and a new trust region (docs/sao.md, "Global
       // phase", restarts); the result is the best point of the whole run (the driver's)
       if (!restart_wanted()) return;
+      const long before = driver_.evaluations();
       const std::optional<bool> restarted = restart();
       if (!restarted || !*restarted) return;
       ++restarts_;
+      last_restart_evaluations_ = before;
       polished = false;
       message += "; restart " + std::to_string(restarts_);
       stalled = 0;
@@ -155,6 +183,7 @@ void SaoRun::run(const std::vector<double>& x0) {
         sampling_ && probed_samples_ > 0 ? std::sqrt(double(probed_samples_) / double(samples_)) : 1.0;
     for (std::size_t k = 0; k < probed_noise_.size() && k < models->noise.size(); ++k)
       models->noise[k] = std::max(models->noise[k], probe_scale * probed_noise_[k]);
+    if (!models->noise.empty() && models->noise[0] > 0) noise_f_ = models->noise[0];
     bool phase1 = false;
     const Eigen::VectorXd s = solve_subproblem(*models, phase1);
     feasibility_phase_ = phase1;

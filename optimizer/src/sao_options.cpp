@@ -131,6 +131,8 @@ void SaoOptions::validate(const std::string& p) const {
           rho_expand_high, "must be >= rho_expand_low = " + format_number(rho_expand_low));
   require_in(p, "short_step", short_step, "[)", 0, 1, "(0: off)");
   require_in(p, "noise_tolerance", noise_tolerance, "[]", 0, 100, "(0: off)");
+  require_in(p, "noise_stop", noise_stop, "[]", 0, 100, "(0: off)");
+  require(noise_stop_window >= 0, p, "noise_stop_window", noise_stop_window, "must be >= 0 (0: automatic, 10 (n + 1))");
   require(std::isfinite(penalty_initial) && penalty_initial >= 0, p, "penalty_initial", penalty_initial,
           "must be >= 0 (0: automatic)");
   require(std::isfinite(penalty_multiplier_factor) && penalty_multiplier_factor >= 1, p, "penalty_multiplier_factor",
@@ -209,6 +211,8 @@ void describe_fields(FieldArchive& a, SaoOptions& o) {
   a.field("short_step", o.short_step);
   a.field("noise_tolerance", o.noise_tolerance);
   a.field("noise_detection", o.noise_detection);
+  a.field("noise_stop", o.noise_stop);
+  a.field("noise_stop_window", o.noise_stop_window, Rule::in_range(0, 1e9));
   a.field("penalty_initial", o.penalty_initial);
   a.field("penalty_multiplier_factor", o.penalty_multiplier_factor);
   a.field("stall_iterations", o.stall_iterations, Rule::in_range(1, 1e6));

@@ -107,7 +107,7 @@ class SaoRun {
  public:
   SaoRun(Problem& problem, const OptimizerOptions& options, const SaoOptions& sao, EvaluationDriver& driver)
       : options_(options), sao_(sao), driver_(driver), variables_(problem.variables()),
-        global_(sao.global_phase.enabled(problem.stochastic())) {
+        global_(sao.global_phase.enabled(problem.stochastic())), stochastic_(problem.stochastic()) {
     n_ = static_cast<int>(variables_.size());
     m_ineq_ = driver.n_inequality();
     m_eq_ = driver.n_equality();
@@ -227,12 +227,21 @@ class SaoRun {
   // second differences of the responses say the merit's noise is comparable to the predicted reduction; nullopt once
   // the run is stopped.
   std::optional<bool> probe_noise(double predicted, bool phase1);
+  // The stop on noise (sao_noise_probe.cpp, docs/sao.md "Stop when the rest is noise"): records
+  // the best feasible objective at the current evaluation count. Restart: it has improved by less
+  // than noise_stop * noise_f_ for noise_stop_window evaluations and no restart has been tried
+  // since (the trust region is treated as converged); Stop: the same, and a restart tried since
+  // has had the window too. None while the objective's noise is unknown.
+  enum class NoiseStall { None, Restart, Stop };
+  NoiseStall noise_stall();
+  long noise_window() const { return sao_.noise_stop_window > 0 ? sao_.noise_stop_window : 10L * (n_ + 1); }
 
   const OptimizerOptions& options_;
   const SaoOptions& sao_;
   EvaluationDriver& driver_;
   std::vector<Variable> variables_;
   bool global_ = false;  // the global phase runs (SaoGlobalPhase::enabled for this problem)
+  bool stochastic_ = false;  // Problem::stochastic(): the stop on noise may act without a probe
   int infill_calls_ = 0;
   int restarts_ = 0;      // trust regions restarted after convergence  // global_infill calls so far (each its own random stream)
   int n_ = 0;
@@ -255,6 +264,11 @@ class SaoRun {
   double last_probe_radius_ = kInf;
   std::vector<double> probed_noise_;  // per response, set when the probe finds noise
   std::size_t probed_samples_ = 0;    // the sample size the probe's noise was measured at
+  // the objective's noise level of the latest fit that knew it (confirmed or probed; 0: unknown)
+  double noise_f_ = 0;
+  // (evaluations, best feasible objective) at the start of every trust-region iteration
+  std::vector<std::pair<long, double>> best_trace_;
+  long last_restart_evaluations_ = -1;  // the evaluation count when the latest restart began
 
   // adaptive sample size (off: samples_ stays the problem's own size and nothing is shifted)
   bool sampling_ = false;

@@ -1,5 +1,6 @@
 // The ADOPT suite's quick form end to end (configs/compare/adopt_suite_quick.yaml, issue 33): every
-// method runs on both startup problems (nominal and over the envelope), every run's design is
+// method runs on the three startup problems (nominal, over issue 30's envelope, the ball count as a
+// variable), every run's design is
 // validated out of sample, and scripts/benchmarks_report.py turns the output into the table of
 // docs/benchmarks.md with a row per method. About a minute on 2 cores: label long.
 #include <gtest/gtest.h>
@@ -52,14 +53,14 @@ TEST(AdoptSuiteCli, QuickFormRunsEveryMethodAndFeedsTheReport) {
     ++per_solver[f[2]];
     if (!f[16].empty()) ++validated;
   }
-  EXPECT_EQ(lines, 2 * 2 * 7);  // problems x starts x methods
+  EXPECT_EQ(lines, 3 * 2 * 7);  // problems x starts x methods
   EXPECT_EQ(validated, lines);  // every run's design checked out of sample
-  for (const char* s : {"SAO", "COBYLA", "SBPLX", "CMA-ES", "xNES", "SADE", "PSO"}) EXPECT_EQ(per_solver[s], 4) << s;
+  for (const char* s : {"SAO", "COBYLA", "SBPLX", "CMA-ES", "xNES", "SADE", "PSO"}) EXPECT_EQ(per_solver[s], 6) << s;
   if (run("python3 -c 'import sys' 2>/dev/null") != 0) GTEST_SKIP() << "no python3 for the report";
   const fs::path md = fs::path(ABUOPT_BINARY_DIR) / "adopt_suite_quick.md";
   ASSERT_EQ(run("python3 " + src + "/scripts/benchmarks_report.py " + dir.string() + " --out " + md.string()), 0);
   const std::string text = read(md);
-  for (const char* p : {"### two_ball_19s", "### two_ball_envelope", "| PSO |", "| SAO |", "evals to 2 %"})
+  for (const char* p : {"### two_ball_19s", "### two_ball_envelope", "### ball_count_19s", "| PSO |", "| SAO |", "evals to 2 %"})
     EXPECT_NE(text.find(p), std::string::npos) << p << "\n" << text;
   fs::remove_all(dir);
 }

@@ -172,8 +172,17 @@ struct SaoOptions {
   // step lengths say the noise is comparable with the predicted reduction, the run switches to regression designs (twice the automatic point count,
   // as doe_points_factor 2) and to a maximum-likelihood nugget for kriging. false: never.
   bool noise_detection = true;
+  // Stop on noise (docs/sao.md, "Stop when the rest is noise"): once the objective's noise level
+  // sigma is known (confirmed from the fits or measured by the probe), the run ends when the best
+  // feasible objective improved by less than noise_stop * sigma over the last noise_stop_window
+  // evaluations of the trust region (restarts included); without it a noisy run spends its whole
+  // budget on improvements the noise cannot tell apart. 0: off. In [0, 100].
+  double noise_stop = 2.0;
+  // The window of that test in evaluations; 0: automatic, 10 (n + 1).
+  int noise_stop_window = 0;
 
-  // Initial exact-penalty weight mu; 0: automatic, 10 max(1, |f(x0)|).
+  // Initial exact-penalty weight mu; 0: automatic, 10 max(1, |f(x0)|) on a stochastic problem,
+  // 1e-3 max(1, |f(x0)|) on a deterministic one (the multiplier estimates raise it).
   double penalty_initial = 0.0;
   // mu >= penalty_multiplier_factor * max |lambda| (estimated multipliers); >= 1.
   double penalty_multiplier_factor = 2.0;
