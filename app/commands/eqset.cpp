@@ -25,6 +25,7 @@
 #include "abuopt/core/equilibrium_set.hpp"
 #include "abuopt/core/simulation_config.hpp"
 #include "commands/commands.hpp"
+#include "commands/eqset_runs.hpp"
 
 namespace abuopt::app {
 
@@ -43,6 +44,9 @@ struct EqsetArgs {
   std::optional<long> grid;
   std::string out;
   bool json = false;
+  EqsetRunsArgs runs;  // --runs RUNS_CSV (commands/eqset_runs.hpp)
+  bool lock_set = false;
+  std::optional<double> alpha;
 };
 
 // The optional `eqset` section of the config; command-line options override it.
@@ -426,10 +430,39 @@ int run_eqset(const EqsetArgs& a) {
   std::optional<Scan> scan;
   if (a.scan) scan = parse_scan(*a.scan);
 
+  if (!a.runs.runs_csv.empty() && a.mu)
+    throw ConfigError("--mu", num_text(*a.mu), "cannot be given with --runs (the runs.csv gives each run's mu)");
+  if (!a.runs.runs_csv.empty() && a.grid)
+    throw ConfigError("--grid", std::to_string(*a.grid), "has no use with --runs (no grid: the runs' own angles)");
+  if (a.lock_set && a.grid && *a.grid > 1024)  // ~80 us per point (281 speeds): 1024^2 points take about 90 s
+    throw ConfigError("--grid", std::to_string(*a.grid), "must be at most 1024 with --lock-set (points per axis)");
+  if (a.lock_set && !a.out.empty())
+    throw ConfigError("--out", a.out, "has no use with --lock-set (it prints its figures; --json for one object)");
+
   YamlReader root = YamlReader::load_file(a.config);
   const SimulationSetup setup = read_simulation_setup(root);
   const EqsetConfig cfg = read_eqset_section(root.child("eqset"));
   finish_config(root);  // a montecarlo (or any other known) section is not used here
+  if (a.alpha && !(std::isfinite(*a.alpha) && *a.alpha >= 0))
+    throw ConfigError("--alpha", num_text(*a.alpha), "must be an angular acceleration >= 0 in rad/s^2");
+  if (a.lock_set) {
+    const std::size_t nb = setup.abu.balls.size();
+    if (nb < 2) throw ConfigError("abu.balls", std::to_string(nb) + " balls", "the lock-set grid needs at least 2 balls");
+    if (cfg.other_angles_rad.size() != nb - 2)
+      throw ConfigError("eqset.other_angles_rad", std::to_string(cfg.other_angles_rad.size()) + " angles",
+                        "must give the fixed angles of balls 3.." + std::to_string(nb) + " (" + std::to_string(nb - 2) +
+                            " values)");
+    AbuParameters abu = setup.abu;
+    if (a.mu) abu.friction_mu = *a.mu;
+    return run_eqset_lock_set(abu, cfg.other_angles_rad, static_cast<std::size_t>(a.grid ? *a.grid : 160),
+                              a.alpha.value_or(0.0), a.json);
+  }
+  if (!a.runs.runs_csv.empty()) {
+    EqsetRunsArgs r = a.runs;
+    r.out = a.out;
+    r.json = a.json;
+    return run_eqset_runs(setup, r);
+  }
   const std::size_t nb = setup.abu.balls.size();
   if (nb < 2) throw ConfigError("abu.balls", std::to_string(nb) + " balls", "the equilibrium-set grid needs at least 2 balls");
   if (cfg.other_angles_rad.size() != nb - 2)
@@ -467,11 +500,28 @@ void register_eqset(CLI::App& app) {
       "    (smallest/median/largest |I_r|, I_r,x over the set and around the balancing points), the band\n"
       "    where the coverage is below 1; with --out also residual.csv/.png/.pdf. '-' (an empty CSV field): that\n"
       "    part has no grid point (the boundary columns outside the band, where the set is the plane).\n"
-      "Exit status: 0 ok, 2 bad input.");
+      "  --runs RUNS_CSV: where the runs of `abuopt montecarlo CONFIG --out DIR` (DIR/runs.csv) stopped against\n"
+      "    the sets: settling speed, gauge, depth |U|/r_lock, the runs locked early (before the band) and late;\n"
+      "    with --out DIR also DIR/final_states.csv (one line per settled run).\n"
+      "  --lock-set: the share of uniform starts in the lock set (a grid, --grid, default 160), their depth and\n"
+      "    lock gauge; with --alpha the share out of a ramp's reach (docs/equilibrium_sets.md section 6).\n"
+      "Exit status: 0 ok, 2 bad input, 3 no settled run (--runs).");
   sub->add_option("config", args->config, "YAML config (section abu; optional section eqset)")->required();
   auto* freq = sub->add_option("--freq", args->freq, "constant speed in Hz (> 0)");
   auto* scan = sub->add_option("--scan", args->scan, "frequency scan FROM:TO:STEP in Hz, e.g. 10:50:0.5");
   freq->excludes(scan);
+  auto* runs = sub->add_option("--runs", args->runs.runs_csv, "runs.csv of `abuopt montecarlo --out DIR`: final states against the sets");
+  runs->excludes(freq);
+  runs->excludes(scan);
+  auto* lock = sub->add_flag("--lock-set", args->lock_set,
+                             "uniform starts in the lock set (in the set of every speed): share, depth, lock gauge");
+  lock->excludes(freq);
+  lock->excludes(scan);
+  lock->excludes(runs);
+  sub->add_option("--alpha", args->alpha, "--lock-set: the peak angular acceleration of a ramp in rad/s^2 (its reach)")
+      ->needs(lock);
+  sub->add_option("--split", args->runs.split, "--runs: early runs by settling speed (speed, default) or before the first passage of the band edge (passage)")->needs(runs);
+  sub->add_option("--edge", args->runs.edge_hz, "--runs: the band edge of the split in Hz (default: the speed below resonance where r_in = 2 r_lock)")->needs(runs);
   sub->add_option("--grid", args->grid, "points per axis of the (beta_1, beta_2) grid, >= 2 (default 128; scan 64)");
   sub->add_option("--mu", args->mu, "override the friction coefficient abu.friction_mu, in [0, 1)");
   sub->add_option("--out", args->out,

@@ -150,6 +150,8 @@ int run_sweep_command(const SweepArgs& a) {
                     {"definition", problems::to_string(st.objective.definition)},
                     {"label", objective_label(st)}};
   j["constraints"] = problem.inequality_names();
+  const auto r_lock = sweep_lock_radius_kgm(st);
+  j["r_lock_kgm"] = r_lock ? nlohmann::json(*r_lock) : nlohmann::json(nullptr);  // depth_mean = mean |I_r| / r_lock
   if (best) {
     nlohmann::json bx = nlohmann::json::object();
     for (std::size_t i = 0; i < vars.size(); ++i) bx[vars[i].name] = best->x[i];

@@ -12,6 +12,7 @@
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/output_file.hpp"
 #include "abuopt/common/text.hpp"
+#include "abuopt/core/final_states.hpp"
 #include "abuopt/core/initial_conditions.hpp"
 #include "abuopt/surrogate/doe.hpp"
 
@@ -248,8 +249,17 @@ double objective_half_width(const problems::StartupProfileSettings& s, const opt
   return it == e.metrics.end() ? std::numeric_limits<double>::quiet_NaN() : it->second;
 }
 
+std::optional<double> sweep_lock_radius_kgm(const problems::StartupProfileSettings& s) {
+  const UncertainParameters& u = s.study.uncertain;
+  if (!u.deterministic() || !u.envelope.empty()) return std::nullopt;
+  AbuParameters p = s.study.setup.abu;
+  if (u.friction.sampling == FrictionSampling::Fixed) p.friction_mu = u.friction.value;
+  return lock_radius_kgm(p);
+}
+
 void write_sweep_csv(const std::filesystem::path& path, const problems::StartupProfileProblem& problem,
                      const SweepResult& r) {
+  const std::optional<double> r_lock = sweep_lock_radius_kgm(problem.settings());
   const auto vars = problem.variables();
   const auto g_names = problem.inequality_names();
   std::set<std::string> metric_names;
@@ -260,7 +270,7 @@ void write_sweep_csv(const std::filesystem::path& path, const problems::StartupP
   for (const auto& v : vars) f << "," << csv_field(v.name);
   for (const auto& n : g_names) f << "," << csv_field("g_" + n);
   for (const auto& n : metric_names) f << "," << csv_field(n);
-  f << ",wall_time_s,message\n";
+  f << ",wall_time_s,message,depth_mean\n";
   for (const auto& p : r.points) {
     const double hw = objective_half_width(problem.settings(), p.e);
     f << p.index + 1 << "," << p.from_archive << "," << p.e.ok << "," << p.feasible << ","
@@ -273,7 +283,11 @@ void write_sweep_csv(const std::filesystem::path& path, const problems::StartupP
       auto it = p.e.metrics.find(n);
       f << "," << (it == p.e.metrics.end() ? "" : csv_number(it->second));
     }
-    f << "," << csv_number(p.wall_time_s) << "," << csv_field(p.e.message) << "\n";
+    f << "," << csv_number(p.wall_time_s) << "," << csv_field(p.e.message) << ",";
+    // mean |I_r| over r_lock (docs/equilibrium_sets.md section 4): empty with uncertain parameters
+    const auto m = p.e.metrics.find("ir_magnitude_mean");
+    if (r_lock && p.e.ok && m != p.e.metrics.end()) f << csv_number(m->second * 1e-7 / *r_lock);
+    f << "\n";
   }
   f.commit();
 }

@@ -212,6 +212,8 @@ std::vector<MapMark> map_marks(const problems::StartupProfileProblem& problem, c
     if (k < 1 || k > segs.size()) return std::nullopt;
     return dt ? segs[k - 1].duration_s : segs[k - 1].end_frequency_hz;
   };
+  // Another segment count is another family: the 2003 design is no point of it.
+  if (problem.settings().design.segments.size() != segs.size()) return marks;
   const auto rx = report_value(vars[swept[0]].name), ry = report_value(vars[swept[1]].name);
   if (rx && ry)
     marks.push_back({*rx, *ry, "2003 report design (" + vars[swept[0]].name + " " + format_number(*rx) + ", " +

@@ -15,6 +15,7 @@
 
 #include "abuopt_child.hpp"
 #include "abuopt_cli.hpp"
+#include "startup_problem_yaml.hpp"
 
 namespace abuopt {
 namespace {
@@ -73,27 +74,8 @@ nlohmann::json read_json(const fs::path& p) {
 }
 
 // A small design problem (sections of `abuopt optimize`) for the archive and total-work cases.
-const char* kOptimizeForArchive = R"(abu:
-  friction_mu: 0.02
-profile:
-  start_frequency_hz: 0
-  segments:
-    - {end_frequency_hz: 25.0, duration_s: 1.0}
-    - {end_frequency_hz: 29.5, duration_s: 10.0}
-    - {end_frequency_hz: 100.0, duration_s: 8.0}
-montecarlo:
-  design: lhs
-  runs: 4
-  seed: 7
-design:
-  segments:
-    - end_frequency_hz: {min: 15, max: 28, x0: 25}
-      duration_s: {min: 0.3, max: 3, x0: 1}
-    - end_frequency_hz: {min: 28, max: 32, x0: 29.5}
-      duration_s: {min: 1, max: 12, x0: 10}
-    - end_frequency_hz: 100
-      duration_s: {min: 1, max: 10, x0: 8}
-objective:
+const std::string kOptimizeForArchive =
+    abuopt_test::kReportAbuAndProfile + abuopt_test::lhs_montecarlo(4) + abuopt_test::kThreeSegmentDesign + R"(objective:
   kind: mean
 validation:
   enabled: false
@@ -302,29 +284,9 @@ TEST(Hardening3Cli, MontecarloStopsOnSigintAndSigtermAndWritesNothingHalf) {
 
 // optimize: the interrupted run keeps its evaluations in the archive; the rerun resumes (the
 // evaluations so far from the archive) and ends where an uninterrupted run ends.
-const char* kOptimize = R"(abu:
-  friction_mu: 0.02
-profile:
-  start_frequency_hz: 0
-  segments:
-    - {end_frequency_hz: 25.0, duration_s: 1.0}
-    - {end_frequency_hz: 29.5, duration_s: 10.0}
-    - {end_frequency_hz: 100.0, duration_s: 8.0}
-simulation:
-  method: event_driven
-montecarlo:
-  design: lhs
-  runs: 96
-  seed: 7
-design:
-  segments:
-    - end_frequency_hz: {min: 15, max: 28, x0: 25}
-      duration_s: {min: 0.3, max: 3, x0: 1}
-    - end_frequency_hz: {min: 28, max: 32, x0: 29.5}
-      duration_s: {min: 1, max: 12, x0: 10}
-    - end_frequency_hz: 100
-      duration_s: {min: 1, max: 10, x0: 8}
-objective:
+const std::string kOptimize =
+    abuopt_test::kReportAbuAndProfile + "simulation:\n  method: event_driven\n" + abuopt_test::lhs_montecarlo(96) +
+    abuopt_test::kThreeSegmentDesign + R"(objective:
   kind: mean
 constraints:
   max_startup_time_s: 20

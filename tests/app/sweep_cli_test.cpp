@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "abuopt_cli.hpp"
+#include "startup_problem_yaml.hpp"
 
 #include <cstdint>
 #include <cstdio>
@@ -99,29 +100,9 @@ void expect_provenance(const nlohmann::json& j, const std::string& config) {
   EXPECT_EQ(j["provenance"]["config_hash"], fnv_of_file(config));
 }
 
-const char* kBase = R"(abu:
-  friction_mu: 0.02
-profile:
-  start_frequency_hz: 0
-  segments:
-    - {end_frequency_hz: 25.0, duration_s: 1.0}
-    - {end_frequency_hz: 29.5, duration_s: 10.0}
-    - {end_frequency_hz: 100.0, duration_s: 8.0}
-simulation:
-  method: event_driven
-montecarlo:
-  design: lhs
-  runs: 8
-  seed: 7
-design:
-  segments:
-    - end_frequency_hz: {min: 15, max: 28, x0: 25}
-      duration_s: {min: 0.3, max: 3, x0: 1}
-    - end_frequency_hz: {min: 28, max: 32, x0: 29.5}
-      duration_s: {min: 1, max: 12, x0: 10}
-    - end_frequency_hz: 100
-      duration_s: {min: 1, max: 10, x0: 8}
-objective:
+const std::string kBase =
+    abuopt_test::kReportAbuAndProfile + "simulation:\n  method: event_driven\n" + abuopt_test::lhs_montecarlo(8) +
+    abuopt_test::kThreeSegmentDesign + R"(objective:
   kind: mean
 validation:
   runs: 16
@@ -155,6 +136,13 @@ TEST(SweepCli, GridSweepWritesEveryPointResumesAndExportsTheSameBits) {
     EXPECT_EQ(a.at(i, "objective_hw95"), a.at(i, "ir_magnitude_mean_hw95"));
   }
   const nlohmann::json s = read_json(out / "summary.json");
+  // depth_mean = mean |I_r| / r_lock; r_lock = 2 bbar sqrt(1 - bbar^2) M L mu / (1 + mu) = 15.90e-7 kg m
+  // at mu 0.02 (docs/equilibrium_sets.md section 4).
+  ASSERT_TRUE(s["r_lock_kgm"].is_number());
+  const double r_lock = s["r_lock_kgm"].get<double>();
+  EXPECT_NEAR(r_lock / 1e-7, 15.90, 0.005);
+  for (std::size_t i = 0; i < 6; ++i)
+    EXPECT_NEAR(parse(a.at(i, "depth_mean")), parse(a.at(i, "ir_magnitude_mean")) * 1e-7 / r_lock, 1e-12) << i;
   expect_provenance(s, cfg);
   EXPECT_EQ(s["points_evaluated"], 6);
   EXPECT_EQ(s["computed"], 6);
@@ -162,6 +150,10 @@ TEST(SweepCli, GridSweepWritesEveryPointResumesAndExportsTheSameBits) {
     EXPECT_TRUE(fs::exists(out / "sweep_map.png")) << first.output;
     EXPECT_TRUE(fs::exists(out / "sweep_map.pdf")) << first.output;
   }
+  // A three-segment family holds the 2003 design: the map marks it.
+  std::ifstream gp(out / "sweep_map.gp");
+  const std::string script((std::istreambuf_iterator<char>(gp)), std::istreambuf_iterator<char>());
+  EXPECT_NE(script.find("2003 report design (dt2 10, dt3 8)"), std::string::npos) << script;
 
   // The rerun computes nothing and reports the same values.
   const Result again = run("sweep " + cfg + " --out " + out.string());
@@ -344,3 +336,43 @@ TEST(SweepCli, CtrlCStopsAfterTheCurrentPointWritesThePointsSoFarAndTheRerunFini
             std::string::npos)
       << rest.output;
 }
+
+// A family with another segment count (here a dwell, as configs/studies/limit/) does not hold the 2003
+// design: its map marks none, even where the swept names f2 / dt2 exist in both.
+TEST(SweepCli, MapMarksThe2003DesignOnlyInAThreeSegmentFamily) {
+  const std::string cfg = write_config("dwell.yaml", R"(abu:
+  friction_mu: 0.02
+profile:
+  start_frequency_hz: 0
+  segments:
+    - {end_frequency_hz: 25.0, duration_s: 1.0}
+    - {end_frequency_hz: 29.0, duration_s: 1.0}
+    - {end_frequency_hz: 29.0, duration_s: 2.0}
+    - {end_frequency_hz: 100.0, duration_s: 4.3}
+simulation:
+  method: event_driven
+montecarlo:
+  design: lhs
+  runs: 4
+  seed: 7
+design:
+  segments:
+    - {}
+    - end_frequency_hz: {min: 28.9, max: 29.5, x0: 29.0}
+      duration_s: {min: 1, max: 10, x0: 1}
+    - {hold: true, duration_s: 2.0}
+    - {}
+objective:
+  kind: mean
+sweep: {method: grid, variables: [f2, dt2], levels: {f2: 2, dt2: 2}}
+)");
+  const fs::path out = fresh_dir("dwell");
+  const Result r = run("sweep " + cfg + " --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  std::ifstream gp(out / "sweep_map.gp");
+  ASSERT_TRUE(gp) << r.output;
+  const std::string script((std::istreambuf_iterator<char>(gp)), std::istreambuf_iterator<char>());
+  EXPECT_NE(script.find("best feasible point"), std::string::npos) << script;
+  EXPECT_EQ(script.find("2003 report design"), std::string::npos) << script;
+}
+

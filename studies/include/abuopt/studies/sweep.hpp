@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -97,8 +98,13 @@ SweepResult run_sweep(opt::Problem& problem, opt::EvaluationArchive& archive, co
                       const SweepProgress& progress = {}, const std::atomic<bool>* stop = nullptr,
                       double constraint_tolerance = 1e-6);
 
+// r_lock of the sweep's ABU (core/final_states.hpp) when every run has the same parameters (no
+// uncertain friction or imbalance, no envelope); nullopt otherwise.
+std::optional<double> sweep_lock_radius_kgm(const problems::StartupProfileSettings& s);
+
 // sweep.csv: one line per point: point, from_archive, ok, feasible, objective, objective_hw95,
-// every variable, g_<constraint>, every metric (sorted), wall_time_s, message. Numbers shortest
+// every variable, g_<constraint>, every metric (sorted), wall_time_s, message, depth_mean (the mean
+// |I_r| over r_lock; empty when sweep_lock_radius_kgm is nullopt). Numbers shortest
 // round-trip; absent values empty.
 void write_sweep_csv(const std::filesystem::path& path, const problems::StartupProfileProblem& problem,
                      const SweepResult& r);
