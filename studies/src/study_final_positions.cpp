@@ -70,6 +70,7 @@ void final_positions(StudyContext& c, const StudyDesign& d, std::uint64_t seed, 
   v.final_baseline = final_states(c.baseline_sample(seed, runs).study, c.file.base.setup.profile, abu, threads, runner);
   v.lock_mu = abu.friction_mu;
   std::tie(v.lock_band_lo_hz, v.lock_band_hi_hz) = lock_band_hz(abu);
+  v.early_edge_hz = band_edge_hz(abu);
   v.lock_n = kLockGrid;
   v.lock_in_set.assign(kLockGrid * kLockGrid, 0);
   for (std::size_t i = 0; i < kLockGrid; ++i)

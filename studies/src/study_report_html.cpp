@@ -277,10 +277,11 @@ std::string study_html(const StudyFile& f, const StudyResult& r) {
          "ABU: shaded, the configurations held at every constant speed (lock gauge &le; 1, docs/equilibrium_sets.md "
          "section 6), the equilibrium set where it is narrowest, in the lock band "
       << sig3(v.lock_band_lo_hz) << " - " << sig3(v.lock_band_hi_hz)
-      << " Hz around the resonance; balls stuck inside it are never moved again. Early runs stuck before the profile reached the band and never moved again, "
-         "wherever they were; late runs were collected by the band. Depth: the residual imbalance |U| over r_lock, "
+      << " Hz around the resonance; balls stuck inside it are never moved again. Early runs stuck for good below "
+      << sig3(v.early_edge_hz)
+      << " Hz (where the set has narrowed to 2 r_lock), wherever they were; late runs were collected in the band. Depth: the residual imbalance |U| over r_lock, "
          "the radius of the narrowest set (each run with its own friction and imbalance); the balancing positions "
-         "(depth 0) lie at the centre of each shaded lobe. A better profile leaves fewer runs early and its late runs "
+         "(depth 0) lie inside the shaded lobes, one for each order of the two balls. A better profile leaves fewer runs early and its late runs "
          "deeper.</figcaption></figure>\n";
   } else if (r.validation.done && r.recommended && r.designs[*r.recommended].balls != 2) {
     h << "<p>Where the balls stopped is drawn for two balls only (this design has "

@@ -180,7 +180,7 @@ struct ParetoFront {
 // The settled runs of one profile on one sample as `abuopt eqset --runs` measures them.
 struct FinalPositions {
   std::vector<std::pair<double, double>> angles_deg;  // final (beta_1, beta_2) of each settled run
-  std::vector<char> early;                            // 1: settled before the band (split by speed)
+  std::vector<char> early;                            // 1: settled below the band edge (split by speed)
   std::vector<double> depth;                          // |U| / r_lock of the run's own parameters
   std::size_t not_settled = 0;
   double early_share = 0, depth_mean = 0, depth_lo = 0, depth_hi = 0;  // mean depth and its 95 % interval
@@ -203,6 +203,7 @@ struct ValidationResult {
   std::size_t lock_n = 0;          // the lock set's grid: lock_n x lock_n over [0, 360)^2 deg
   std::vector<char> lock_in_set;   // row-major: index i * lock_n + j = (beta_1 = i, beta_2 = j)
   double lock_mu = 0, lock_band_lo_hz = 0, lock_band_hi_hz = 0;
+  double early_edge_hz = 0;        // early: settled below this speed (r_in = 2 r_lock, nominal ABU)
 };
 
 struct StudyResult {
