@@ -283,9 +283,9 @@ std::string study_html(const StudyFile& f, const StudyResult& r) {
          "the radius of the narrowest set (each run with its own friction and imbalance); the balancing positions "
          "(depth 0) lie inside the shaded lobes, one for each order of the two balls. A better profile leaves fewer runs early and its late runs "
          "deeper.</figcaption></figure>\n";
-  } else if (r.validation.done && r.recommended && r.designs[*r.recommended].balls != 2) {
-    h << "<p>Where the balls stopped is drawn for two balls only (this design has "
-      << r.designs[*r.recommended].balls << ").</p>\n";
+  } else if (r.validation.done && r.recommended) {
+    h << "<p>Where the balls stopped is drawn when the design and the baseline both have two balls (this design has "
+      << r.designs[*r.recommended].balls << ", the baseline " << f.base.setup.abu.balls.size() << ").</p>\n";
   }
 
   // ---- the Pareto front ----
