@@ -231,6 +231,15 @@ std::string markdown(const StudyFile& f, const StudyResult& r) {
         md << "| " << label << " | " << interval_text(v.design.at(k)) << " | " << interval_text(v.baseline.at(k)) << " |\n";
       md << "\nRatio of mean |I_r| (" << rec->label << " / baseline): " << interval_text(v.ratio_mean_ir) << ". "
          << verdict_text(v) << "\n\n";
+      if (!v.final_design.angles_deg.empty() && !v.final_baseline.angles_deg.empty()) {
+        const auto balls = [](const FinalPositions& p) {
+          return sig3(100.0 * p.early_share) + " % early, mean depth |U|/r_lock " +
+                 sig3(p.depth_mean) + " [" + sig3(p.depth_lo) + ", " + sig3(p.depth_hi) + "]";
+        };
+        md << "Where the balls stopped (first fresh sample, settled runs; early: stuck for good below "
+           << sig3(v.early_edge_hz) << " Hz, where the set has narrowed to 2 r_lock): " << rec->label << " "
+           << balls(v.final_design) << "; baseline " << balls(v.final_baseline) << ".\n\n";
+      }
     }
   }
   if (r.choice_summary.size() > 1) {
@@ -344,6 +353,17 @@ nlohmann::json summary(const StudyFile& f, const StudyResult& r) {
     if (!v.map_ratio.empty())
       j["validation"]["map"] = {{"friction_mu", v.map_mu}, {"imbalance_mass_factor", v.map_imbalance},
                                 {"runs", v.map_runs}, {"ratio_mean_abs_ir", v.map_ratio}};
+    if (!v.final_design.angles_deg.empty() || !v.final_baseline.angles_deg.empty()) {
+      const auto fp = [](const FinalPositions& p) {
+        return nlohmann::json{{"settled", p.angles_deg.size()}, {"not_settled", p.not_settled},
+                              {"early_share", p.early_share}, {"early_depth_mean", p.early_depth_mean},
+                              {"late_depth_mean", p.late_depth_mean},
+                              {"depth_mean", {{"mean", p.depth_mean}, {"lo95", p.depth_lo}, {"hi95", p.depth_hi}}}};
+      };
+      j["validation"]["final_positions"] = {{"design", fp(v.final_design)}, {"baseline", fp(v.final_baseline)},
+                                            {"lock_band_hz", {v.lock_band_lo_hz, v.lock_band_hi_hz}},
+                                            {"early_edge_hz", v.early_edge_hz}, {"lock_mu", v.lock_mu}};
+    }
   }
   if (!r.front.points.empty()) {
     const ParetoFront& fr = r.front;

@@ -43,6 +43,7 @@ table{border-collapse:collapse;margin:0.6em 0;font-size:0.9em} td,th{border:1px 
 th{background:#eee} td.num{text-align:right;font-variant-numeric:tabular-nums}
 figure{margin:1em 0} figcaption{font-size:0.9em;color:#444;max-width:720px}
 .small{font-size:0.85em;color:#555}
+.panels{display:flex;flex-wrap:wrap;gap:1em} .panels p{font-size:0.9em;max-width:500px;margin:0.2em 0}
 )";
 
 // "2 balls", a set's name, or "ball count a variable" (a global stage over the count)
@@ -249,23 +250,42 @@ std::string study_html(const StudyFile& f, const StudyResult& r) {
       << "Below 1 (blue): the design is better than the baseline there.</figcaption></figure>\n";
   }
 
-  // ---- final positions over the equilibrium set ----
-  if (!r.validation.final_design.empty()) {
+  // ---- final positions over the lock set ----
+  if (!r.validation.final_design.angles_deg.empty() || !r.validation.final_baseline.angles_deg.empty()) {
     const ValidationResult& v = r.validation;
-    std::vector<SvgPointGroup> groups = {
-        {"baseline (" + std::to_string(v.final_baseline.size()) + " runs)", "#555555", v.final_baseline, true},
-        {who + " design (" + std::to_string(v.final_design.size()) + " runs)", "#d62728", v.final_design, false}};
-    h << "<h2>Final ball positions over the equilibrium set</h2>\n<figure>"
-      << svg_points_over_set("Final angles of the two balls", "beta_1 [deg]", "beta_2 [deg]", v.eq_n, v.eq_in_set,
-                             "equilibrium set (" + sig3(v.eq_frequency_hz) + " Hz, mu " + sig3(v.eq_mu) + ")",
-                             groups)
-      << "<figcaption>Where the balls stop, on the first fresh sample of the validation (the envelope's draws per run). "
-         "Shaded: the configurations in which both balls can stay stuck at the last frequency with the nominal "
-         "friction (report section 4.2), "
-      << sig3(100.0 * static_cast<double>(std::count(v.eq_in_set.begin(), v.eq_in_set.end(), 1)) /
-              static_cast<double>(std::max<std::size_t>(1, v.eq_in_set.size())))
-      << " % of the torus; the balancing positions lie where the residual imbalance vanishes."
-         "</figcaption></figure>\n";
+    const auto pct = [](double share) { return sig3(100.0 * share) + " %"; };
+    const auto panel = [&](const std::string& name, const FinalPositions& fp) {
+      SvgPointGroup early{"", "#ff7f0e", {}, false}, late{"", "#1f77b4", {}, false};
+      for (std::size_t k = 0; k < fp.angles_deg.size(); ++k) (fp.early[k] ? early : late).points.push_back(fp.angles_deg[k]);
+      early.name = "early (" + std::to_string(early.points.size()) + " runs)";
+      late.name = "late (" + std::to_string(late.points.size()) + " runs)";
+      std::ostringstream o;
+      o << "<div>"
+        << svg_points_over_set(name + ": final angles of the two balls", "beta_1 [deg]", "beta_2 [deg]", v.lock_n,
+                               v.lock_in_set, "lock set (mu " + sig3(v.lock_mu) + ")", {early, late}, 350, 165)
+        << "<p>" << xml_escape(name) << ": " << fp.angles_deg.size() << " settled runs";
+      if (fp.not_settled) o << " (" << fp.not_settled << " not settled, not drawn)";
+      o << "; early " << pct(fp.early_share) << " (mean depth " << sig3(fp.early_depth_mean) << "), late "
+        << pct(1.0 - fp.early_share) << " (" << sig3(fp.late_depth_mean) << "); mean depth |U|/r_lock "
+        << sig3(fp.depth_mean) << " [" << sig3(fp.depth_lo) << ", " << sig3(fp.depth_hi) << "]</p></div>";
+      return o.str();
+    };
+    h << "<h2>Where the balls stopped</h2>\n<figure><div class=\"panels\">"
+      << panel("baseline", v.final_baseline) << panel(who + " design", v.final_design)
+      << "</div><figcaption>The final angles of the two balls on the first fresh sample of the validation (the "
+         "envelope's draws per run, the same initial angles for both profiles), over the lock set of the nominal "
+         "ABU: shaded, the configurations held at every constant speed (lock gauge &le; 1, docs/equilibrium_sets.md "
+         "section 6), the equilibrium set where it is narrowest, in the lock band "
+      << sig3(v.lock_band_lo_hz) << " - " << sig3(v.lock_band_hi_hz)
+      << " Hz around the resonance; balls stuck inside it are never moved again. Early runs stuck for good below "
+      << sig3(v.early_edge_hz)
+      << " Hz (where the set has narrowed to 2 r_lock), wherever they were; late runs were collected in the band. Depth: the residual imbalance |U| over r_lock, "
+         "the radius of the narrowest set (each run with its own friction and imbalance); the balancing positions "
+         "(depth 0) lie inside the shaded lobes, one for each order of the two balls. A better profile leaves fewer runs early and its late runs "
+         "deeper.</figcaption></figure>\n";
+  } else if (r.validation.done && r.recommended) {
+    h << "<p>Where the balls stopped is drawn when the design and the baseline both have two balls (this design has "
+      << r.designs[*r.recommended].balls << ", the baseline " << f.base.setup.abu.balls.size() << ").</p>\n";
   }
 
   // ---- the Pareto front ----

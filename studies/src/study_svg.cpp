@@ -215,8 +215,8 @@ std::string svg_heatmap(const std::string& title, const std::string& x_label, co
 
 std::string svg_points_over_set(const std::string& title, const std::string& x_label, const std::string& y_label,
                                 std::size_t n, const std::vector<char>& in_set, const std::string& set_name,
-                                const std::vector<SvgPointGroup>& groups, int size) {
-  const int width = size + 360, height = size;
+                                const std::vector<SvgPointGroup>& groups, int size, int legend_width) {
+  const int width = size + legend_width, height = size;
   const double L = 70, T = 30, B = height - 50.0, R = L + (B - T);
   const auto X = [&](double deg) { return L + deg / 360.0 * (R - L); };
   const auto Y = [&](double deg) { return B - deg / 360.0 * (B - T); };

@@ -34,7 +34,7 @@ struct SvgPointGroup {
 };
 std::string svg_points_over_set(const std::string& title, const std::string& x_label, const std::string& y_label,
                                 std::size_t n, const std::vector<char>& in_set, const std::string& set_name,
-                                const std::vector<SvgPointGroup>& groups, int size = 520);
+                                const std::vector<SvgPointGroup>& groups, int size = 520, int legend_width = 360);
 
 // Text with &, <, >, " escaped for HTML and SVG.
 std::string xml_escape(const std::string& s);

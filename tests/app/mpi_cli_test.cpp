@@ -159,10 +159,10 @@ TEST(MpiCli, OptimizeOverTwoRanksIsIdenticalToOneProcess) {
 
 // `abuopt study` (docs/study.md): every Monte Carlo of the stages (optimisers, replications,
 // validation, the map, the final positions) over the ranks; summary.json identical to one
-// process's. The quick study shrunk to seconds (as tests/app/study_cli_test.py's tiny study).
+// process's. The test fixture study shrunk to seconds (as tests/app/study_cli_test.py's tiny study).
 TEST(MpiCli, StudyOverTwoRanksIsIdenticalToOneProcess) {
   REQUIRE_MPI();
-  std::ifstream in(std::string(ABUOPT_SOURCE_DIR) + "/configs/studies/quick.yaml");
+  std::ifstream in(std::string(ABUOPT_SOURCE_DIR) + "/tests/studies/data/study_fixture.yaml");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::pair<std::string, std::string> shrink[] = {
       {"runs: 64, seed: 21", "runs: 8, seed: 21"},
@@ -174,7 +174,7 @@ TEST(MpiCli, StudyOverTwoRanksIsIdenticalToOneProcess) {
        "map: {friction_mu: [0.03], imbalance_mass_factor: [0.8, 1.2], runs: 8}"}};
   for (const auto& [from, to] : shrink) {
     const auto at = text.find(from);
-    ASSERT_NE(at, std::string::npos) << "configs/studies/quick.yaml lacks: " << from;
+    ASSERT_NE(at, std::string::npos) << "tests/studies/data/study_fixture.yaml lacks: " << from;
     text.replace(at, from.size(), to);
   }
   const fs::path dir = fresh_dir("study");

@@ -17,9 +17,11 @@ using namespace abuopt::studies;
 namespace fs = std::filesystem;
 
 const std::string kQuick = std::string(ABUOPT_SOURCE_DIR) + "/configs/studies/quick.yaml";
+// The file the tests edit: the quick study as it was (a global and a local stage), kept fixed.
+const std::string kFixture = std::string(ABUOPT_SOURCE_DIR) + "/tests/studies/data/study_fixture.yaml";
 
 std::string quick_text() {
-  std::ifstream in(kQuick);
+  std::ifstream in(kFixture);
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
@@ -50,19 +52,24 @@ std::string replace(std::string s, const std::string& from, const std::string& t
 }
 
 TEST(StudyFile, QuickStudyReads) {
-  const StudyFile f = read_study_file(kQuick);
-  ASSERT_EQ(f.stages.size(), 4u);
-  EXPECT_EQ(f.stages[0].kind, StageKind::Global);
-  EXPECT_EQ(f.stages[3].kind, StageKind::Validate);
-  EXPECT_EQ(f.stages[3].seeds.size(), 4u);
+  const StudyFile f = read_study_file(kQuick);  // a local polish from a known start, replications, validation
+  ASSERT_EQ(f.stages.size(), 3u);
+  EXPECT_EQ(f.stages[0].kind, StageKind::Local);
+  EXPECT_EQ(f.stages[2].kind, StageKind::Validate);
+  EXPECT_EQ(f.stages[2].seeds.size(), 4u);
   EXPECT_TRUE(f.frequencies_natural);
   ASSERT_EQ(f.choices.size(), 1u);
   EXPECT_EQ(f.choices[0].balls.size(), 2u);
   EXPECT_EQ(f.choices[0].label, "balls2");
   EXPECT_FALSE(f.ball_count_variable);
-  EXPECT_EQ(f.base.runs, 64u);
+  EXPECT_EQ(f.base.runs, 128u);
   EXPECT_EQ(f.base.uncertain.envelope.friction_mu.kind, DistributionKind::Uniform);
   EXPECT_EQ(f.base.uncertain.envelope.imbalance_mass_factor.hi, 1.2);
+  const StudyFile g = read_study_file(kFixture);  // the file the other tests edit
+  ASSERT_EQ(g.stages.size(), 4u);
+  EXPECT_EQ(g.stages[0].kind, StageKind::Global);
+  EXPECT_EQ(g.stages[3].kind, StageKind::Validate);
+  EXPECT_EQ(g.base.runs, 64u);
 }
 
 TEST(StudyFile, FrequencyBoundsFollowTheNaturalFrequency) {
@@ -84,7 +91,7 @@ TEST(StudyFile, FrequencyBoundsFollowTheNaturalFrequency) {
 }
 
 TEST(StudyFile, RelativeConstraintsUseTheBaseline) {
-  const StudyFile f = read_study_file(kQuick);
+  const StudyFile f = read_study_file(kFixture);
   const auto s = settings_of_choice(f, 0, {{"amplitude_max_mm", 0.484}});
   ASSERT_TRUE(s.constraints.max_amplitude_mm);
   EXPECT_DOUBLE_EQ(*s.constraints.max_amplitude_mm, 0.484);

@@ -177,6 +177,16 @@ struct ParetoFront {
   Interval baseline_out_of_sample_ir;  // the baseline on the same fresh samples
 };
 
+// The settled runs of one profile on one sample as `abuopt eqset --runs` measures them.
+struct FinalPositions {
+  std::vector<std::pair<double, double>> angles_deg;  // final (beta_1, beta_2) of each settled run
+  std::vector<char> early;                            // 1: settled below the band edge (split by speed)
+  std::vector<double> depth;                          // |U| / r_lock of the run's own parameters
+  std::size_t not_settled = 0;
+  double early_share = 0, depth_mean = 0, depth_lo = 0, depth_hi = 0;  // mean depth and its 95 % interval
+  double early_depth_mean = 0, late_depth_mean = 0;
+};
+
 struct ValidationResult {
   bool done = false;
   std::size_t runs = 0;
@@ -186,12 +196,14 @@ struct ValidationResult {
   std::vector<double> map_mu, map_imbalance;
   std::vector<std::vector<double>> map_ratio;        // [imbalance factor][mu]: design / baseline mean |I_r|
   std::size_t map_runs = 0;
-  // Final ball angles [deg] of the recommended design and the baseline on the first fresh sample
-  // (two balls only), over the equilibrium set at the last frequency and the nominal friction.
-  std::vector<std::pair<double, double>> final_design, final_baseline;
-  std::size_t eq_n = 0;            // the set's grid: eq_n x eq_n over [0, 360)^2 deg
-  std::vector<char> eq_in_set;     // row-major: index i * eq_n + j = (beta_1 = i, beta_2 = j)
-  double eq_frequency_hz = 0, eq_mu = 0;
+  // Where the balls of the recommended design and of the baseline stopped on the first fresh sample
+  // (two balls only), over the lock set of the nominal ABU (lock gauge <= 1: held at every constant
+  // speed; core/include/abuopt/core/final_states.hpp).
+  FinalPositions final_design, final_baseline;
+  std::size_t lock_n = 0;          // the lock set's grid: lock_n x lock_n over [0, 360)^2 deg
+  std::vector<char> lock_in_set;   // row-major: index i * lock_n + j = (beta_1 = i, beta_2 = j)
+  double lock_mu = 0, lock_band_lo_hz = 0, lock_band_hi_hz = 0;
+  double early_edge_hz = 0;        // early: settled below this speed (r_in = 2 r_lock, nominal ABU)
 };
 
 struct StudyResult {
