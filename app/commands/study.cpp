@@ -22,12 +22,17 @@ struct StudyArgs {
   std::string file, out;
   std::optional<long> threads;
   bool progress = false;
+  bool check = false;
 };
 
 int run_study_command(const StudyArgs& a) {
   const studies::StudyFile f = studies::read_study_file(a.file);
   if (a.threads && *a.threads < 0)
     throw ConfigError("--threads", std::to_string(*a.threads), "must be >= 0 (0 = all cores)");
+  if (a.check) {  // the file read and validated as a run reads it; the plan, nothing simulated
+    std::cout << studies::plan_text(f) << std::flush;
+    return 0;
+  }
   const std::string out = a.out.empty() ? "results/" + std::filesystem::path(a.file).stem().string() : a.out;
   const OutputDirLock lock(out);
   std::cout << "study " << a.file << " (" << f.title << "): " << f.ball_counts.size() << " choice(s), "
@@ -92,6 +97,10 @@ void register_study(CLI::App& app) {
   sub->add_option("study", args->file, "study file (YAML)")->required();
   sub->add_option("--out", args->out, "output directory (default results/<study file stem>)");
   sub->add_option("--threads", args->threads, "Monte Carlo worker threads (0 = all cores; results do not depend on it)");
+  sub->add_flag("--check", args->check,
+                "read and validate the file as a run would (exit 2 on bad input), print the plan (f_n, free\n"
+                "variables with bounds in Hz, choices, stages, budget, estimated simulations) and exit 0\n"
+                "without simulating anything");
   sub->add_flag("--progress", args->progress, "show evaluations done, rate and ETA also when stderr is not a terminal");
   sub->callback([args] { set_exit_code(run_study_command(*args)); });
 }

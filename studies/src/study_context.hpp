@@ -52,12 +52,29 @@ struct StudyContext {
   problems::StartupProfileSettings baseline_settings() const;
 };
 
+// One optimiser run of a stage on one problem through its archive (an optimiser that takes bounds
+// only sees the exact-penalty form), at most max_evaluations (within the stage's own), from x0
+// (empty: the family's); counts the budget, the progress and the trace.
+struct OptimiserRun {
+  std::vector<double> best_x;  // the best feasible point (none feasible: the optimiser's last best; empty: no evaluation)
+  bool feasible = false;
+  StageTrace trace;
+};
+OptimiserRun run_archived_optimiser(StudyContext& c, const StageSpec& stage, const std::string& trace_name,
+                                    std::size_t balls, problems::StartupProfileProblem& problem,
+                                    opt::ArchivedProblem& archived, long max_evaluations, const std::vector<double>& x0,
+                                    std::vector<double>& least_violation);
+// A design of the study at x of `problem` (its in-sample evaluation from the archive).
+StudyDesign design_at(const ChoiceContext& ch, problems::StartupProfileProblem& problem, opt::ArchivedProblem& archived,
+                      const std::string& label, const std::string& stage, const std::vector<double>& x);
+
 // One optimiser stage on every choice (global: from the family's x0; local: from the best so far).
 void run_optimiser_stage(StudyContext& c, const StageSpec& stage, bool from_best);
 void run_global_stage(StudyContext& c, const StageSpec& stage);
 void run_local_stage(StudyContext& c, const StageSpec& stage);
 void run_replicate_stage(StudyContext& c, const StageSpec& stage);
 void run_validate_stage(StudyContext& c, const StageSpec& stage);
+void run_pareto_stage(StudyContext& c, const StageSpec& stage);
 // The final positions of the recommended design and the baseline over the equilibrium set (two
 // balls; studies/src/study_final_positions.cpp).
 void final_positions(StudyContext& c, const StudyDesign& d, std::uint64_t seed, std::size_t runs);

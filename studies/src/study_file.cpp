@@ -3,6 +3,7 @@
 // simulation, the profile, the Monte Carlo sampling, the uncertain parameters, the design family,
 // the objective and constraints) are read through their own field lists; only the study's own keys
 // (choices, relative constraints, stages, budget) are read here.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -18,7 +19,8 @@ namespace abuopt::studies {
 const EnumNames<StageKind> kStageKindNames = {{StageKind::Global, "global"},
                                               {StageKind::Local, "local"},
                                               {StageKind::Replicate, "replicate"},
-                                              {StageKind::Validate, "validate"}};
+                                              {StageKind::Validate, "validate"},
+                                              {StageKind::Pareto, "pareto"}};
 
 std::string to_string(StageKind k) { return enum_name(kStageKindNames, k); }
 
@@ -39,12 +41,24 @@ std::vector<std::uint64_t> read_seeds(YamlReader& r, const std::string& key) {
 StageSpec read_stage(YamlReader& r) {
   StageSpec s;
   if (!r.has("kind"))
-    throw ConfigError(r.key_path("kind"), "<missing>", "is required (global, local, replicate or validate)");
-  const std::string kind = r.get_choice_or("kind", "", {"global", "local", "replicate", "validate"});
+    throw ConfigError(r.key_path("kind"), "<missing>", "is required (global, local, pareto, replicate or validate)");
+  const std::string kind = r.get_choice_or("kind", "", {"global", "local", "pareto", "replicate", "validate"});
   for (const auto& [k, name] : kStageKindNames)
     if (name == kind) s.kind = k;
   s.name = r.get_string_or("name", kind);
-  const bool optimiser = s.kind == StageKind::Global || s.kind == StageKind::Local;
+  const bool optimiser = s.kind == StageKind::Global || s.kind == StageKind::Local || s.kind == StageKind::Pareto;
+  if (s.kind == StageKind::Pareto) {
+    r.get_choice_or("over", "startup_time", {"startup_time"});
+    if (!r.has("bounds"))
+      throw ConfigError(r.key_path("bounds"), "<missing>",
+                        "is required for a pareto stage (the bounds on the startup time [s], e.g. [8, 11, 15, 19])");
+    s.pareto_bounds = r.get_double_list("bounds", Rule::positive_at_most(1e4));
+    if (s.pareto_bounds.empty()) throw ConfigError(r.key_path("bounds"), "[]", "must hold at least one bound");
+    std::sort(s.pareto_bounds.begin(), s.pareto_bounds.end());
+    for (std::size_t i = 1; i < s.pareto_bounds.size(); ++i)
+      if (s.pareto_bounds[i] == s.pareto_bounds[i - 1])
+        throw ConfigError(r.key_path("bounds"), format_number(s.pareto_bounds[i]), "each bound may appear once");
+  }
   if (optimiser) {
     if (!r.has("optimizer"))
       throw ConfigError(r.key_path("optimizer"), "<missing>",
@@ -53,11 +67,17 @@ StageSpec read_stage(YamlReader& r) {
     s.optimizer = opt::read_optimizer_options(o);
     s.optimizer.validate();
     s.penalty_weight = r.get_double_or("penalty_weight", s.penalty_weight, Rule::positive());
-    for (const char* k : {"seeds", "runs", "map"})
-      if (r.has(k)) throw ConfigError(r.key_path(k), "<given>", "is only used by replicate and validate stages");
+    if (s.kind == StageKind::Pareto) {  // optional: the front's points on fresh samples
+      if (r.has("seeds")) s.seeds = read_seeds(r, "seeds");
+      s.runs = static_cast<std::size_t>(r.get_int_or("runs", 0, Rule::in_range(0, 1e7)));
+      if (r.has("map")) throw ConfigError(r.key_path("map"), "<given>", "is only used by the validate stage");
+    } else {
+      for (const char* k : {"seeds", "runs", "map"})
+        if (r.has(k)) throw ConfigError(r.key_path(k), "<given>", "is only used by replicate, validate and pareto stages");
+    }
   } else {
     if (r.has("optimizer"))
-      throw ConfigError(r.key_path("optimizer"), "<given>", "is only used by global and local stages");
+      throw ConfigError(r.key_path("optimizer"), "<given>", "is only used by global, local and pareto stages");
     if (!r.has("seeds"))
       throw ConfigError(r.key_path("seeds"), "<missing>",
                         "is required for a " + kind + " stage (one fresh sample per seed, e.g. [101, 102])");
@@ -91,6 +111,8 @@ void check_stage_order(std::vector<StageSpec>& stages, const std::string& path) 
     if (k == StageKind::Replicate && replicate_seen) throw ConfigError(key, "replicate", "only one replicate stage");
     if ((k == StageKind::Replicate || k == StageKind::Validate) && !optimiser_seen)
       throw ConfigError(key, to_string(k), "needs a global or local stage before it (a design to check)");
+    if (k == StageKind::Pareto && !optimiser_seen)
+      throw ConfigError(key, "pareto", "needs a global or local stage before it (the front starts from its best design)");
     optimiser_seen |= k == StageKind::Global || k == StageKind::Local;
     replicate_seen |= k == StageKind::Replicate;
     validate_seen |= k == StageKind::Validate;

@@ -147,8 +147,8 @@ std::string markdown(const StudyFile& f, const StudyResult& r) {
       md << "On " << v.seeds.size() << " fresh samples of " << v.runs
          << " runs over the envelope (mean and 95 % interval over the samples):\n\n"
          << "| | recommended | baseline |\n|---|---|---|\n";
-      const std::pair<const char*, const char*> rows[] = {{"ir_magnitude_mean", "mean |I_r| [1e-7 kg m]"},
-                                                         {"ir_magnitude_max", "max |I_r| [1e-7 kg m]"},
+      const std::pair<const char*, const char*> rows[] = {{"ir_magnitude_mean", "mean \\|I_r\\| [1e-7 kg m]"},
+                                                         {"ir_magnitude_max", "max \\|I_r\\| [1e-7 kg m]"},
                                                          {"pct_mi", "%MI"},
                                                          {"amplitude_max_mm", "peak amplitude [mm]"}};
       for (const auto& [k, label] : rows)
@@ -162,7 +162,7 @@ std::string markdown(const StudyFile& f, const StudyResult& r) {
     for (const auto& n : r.notes) md << "- " << n << "\n";
     md << "\n";
   }
-  md << "## Designs\n\n| design | balls | stage | objective (in sample) | objective (replicated) | feasible | mean |I_r| | "
+  md << "## Designs\n\n| design | balls | stage | objective (in sample) | objective (replicated) | feasible | mean \\|I_r\\| | "
         "%MI | peak amplitude [mm] | T [s] | profile |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
   md << "| baseline | " << f.base.setup.abu.balls.size() << " | - | " << sig3(r.baseline.objective) << " | - | "
      << (feasible(r.baseline) ? "yes" : "no") << " | " << sig3(metric(r.baseline, "ir_magnitude_mean")) << " | "
@@ -175,6 +175,28 @@ std::string markdown(const StudyFile& f, const StudyResult& r) {
        << " | " << sig3(metric(d.in_sample, "ir_magnitude_mean")) << " | " << sig3(metric(d.in_sample, "pct_mi"))
        << " | " << sig3(metric(d.in_sample, "amplitude_max_mm")) << " | " << sig3(d.profile.duration_s()) << " | "
        << profile_text(d.profile) << " |\n";
+  if (!r.front.points.empty()) {
+    const ParetoFront& fr = r.front;
+    const bool oos = !fr.seeds.empty();
+    md << "\n## Pareto front (stage " << fr.stage << ")\n\nThe least objective at each bound on the startup time T "
+       << "(epsilon-constraint), mean |I_r| in 1e-7 kg m; "
+       << (oos ? "in sample and on " + std::to_string(fr.seeds.size()) + " fresh samples of " + std::to_string(fr.runs) +
+                     " runs (mean and 95 % interval).\n\n"
+               : "in sample only (biased low: the optimiser chose on that sample).\n\n")
+       << "| bound on T [s] | balls | T [s] | mean \\|I_r\\| in sample | " << (oos ? "mean \\|I_r\\| fresh | feasible fresh | " : "")
+       << "%MI | feasible | dominated | config |\n|---|---|---|---|" << (oos ? "---|---|" : "") << "---|---|---|---|\n";
+    for (const FrontPoint& p : fr.points) {
+      md << "| " << sig3(p.bound_s) << " | " << p.design.balls << " | " << sig3(p.design.profile.duration_s()) << " | "
+         << sig3(metric(p.design.in_sample, "ir_magnitude_mean")) << " | ";
+      if (oos) md << interval_text(p.out_of_sample_ir) << " | " << (p.feasible_out_of_sample ? "yes" : "no") << " | ";
+      md << sig3(metric(p.design.in_sample, "pct_mi")) << " | " << (p.feasible ? "yes" : "no") << " | "
+         << (p.dominated ? "yes" : "no") << " | designs/" << p.design.label << ".yaml |\n";
+    }
+    md << "| baseline | " << f.base.setup.abu.balls.size() << " | " << sig3(f.base.setup.profile.duration_s()) << " | "
+       << sig3(metric(r.baseline, "ir_magnitude_mean")) << " | ";
+    if (oos) md << interval_text(fr.baseline_out_of_sample_ir) << " | - | ";
+    md << sig3(metric(r.baseline, "pct_mi")) << " | - | - | - |\n";
+  }
   md << "\n## Stages\n\n| stage | balls | algorithm | reason | evaluations | from archive |\n|---|---|---|---|---|---|\n";
   for (const auto& t : r.traces)
     md << "| " << t.stage << " | " << t.balls << " | " << t.algorithm << " | " << t.reason << " | " << t.evaluations
@@ -232,6 +254,37 @@ nlohmann::json summary(const StudyFile& f, const StudyResult& r) {
       j["validation"]["map"] = {{"friction_mu", v.map_mu}, {"imbalance_mass_factor", v.map_imbalance},
                                 {"runs", v.map_runs}, {"ratio_mean_abs_ir", v.map_ratio}};
   }
+  if (!r.front.points.empty()) {
+    const ParetoFront& fr = r.front;
+    nlohmann::json pts = nlohmann::json::array();
+    for (const FrontPoint& p : fr.points) {
+      nlohmann::json x = nlohmann::json::object();
+      for (std::size_t i = 0; i < p.design.x.size() && i < p.design.variable_names.size(); ++i)
+        x[p.design.variable_names[i]] = p.design.x[i];
+      nlohmann::json jp = {{"bound_s", p.bound_s},
+                           {"label", p.design.label},
+                           {"balls", p.design.balls},
+                           {"startup_time_s", p.design.profile.duration_s()},
+                           {"x", x},
+                           {"profile", profile_json(p.design.profile)},
+                           {"in_sample", evaluation_json(p.design.in_sample, r.constraint_names)},
+                           {"feasible", p.feasible},
+                           {"dominated", p.dominated},
+                           {"evaluations", p.evaluations},
+                           {"file", "designs/" + p.design.label + ".yaml"}};
+      if (!fr.seeds.empty()) {
+        jp["out_of_sample_mean_abs_ir"] = interval_json(p.out_of_sample_ir);
+        jp["feasible_out_of_sample"] = p.feasible_out_of_sample;
+      }
+      pts.push_back(jp);
+    }
+    j["pareto"] = {{"stage", fr.stage}, {"points", pts}};
+    if (!fr.seeds.empty()) {
+      j["pareto"]["seeds"] = fr.seeds;
+      j["pareto"]["runs"] = fr.runs;
+      j["pareto"]["baseline_out_of_sample_mean_abs_ir"] = interval_json(fr.baseline_out_of_sample_ir);
+    }
+  }
   j["traces"] = nlohmann::json::array();
   for (const auto& t : r.traces) {
     nlohmann::json best = nlohmann::json::array();
@@ -251,6 +304,11 @@ std::vector<std::string> write_study_report(const StudyFile& f, const StudyResul
   for (const auto& d : r.designs) {
     const fs::path p = out / "designs" / (d.label + ".yaml");
     write_file_atomic(p, design_yaml(f, r, d));
+    files.push_back(p.string());
+  }
+  for (const auto& fp : r.front.points) {
+    const fs::path p = out / "designs" / (fp.design.label + ".yaml");
+    write_file_atomic(p, design_yaml(f, r, fp.design));
     files.push_back(p.string());
   }
   write_file_atomic(out / "summary.json", summary(f, r).dump(2) + "\n");

@@ -44,6 +44,85 @@ figure{margin:1em 0} figcaption{font-size:0.9em;color:#444;max-width:720px}
 .small{font-size:0.85em;color:#555}
 )";
 
+std::string pareto_html(const StudyFile& f, const StudyResult& r) {
+  const ParetoFront& fr = r.front;
+  const bool oos = !fr.seeds.empty();
+  std::ostringstream h;
+  std::vector<SvgSeries> series;
+  std::vector<std::size_t> counts;
+  for (const FrontPoint& p : fr.points)
+    if (std::find(counts.begin(), counts.end(), p.design.balls) == counts.end()) counts.push_back(p.design.balls);
+  for (std::size_t k = 0; k < counts.size(); ++k) {
+    SvgSeries in, out;
+    const std::string who = counts.size() > 1 ? std::to_string(counts[k]) + " balls, " : "";
+    in.name = who + "in sample (" + std::to_string(f.base.runs) + " runs)";
+    out.name = who + "fresh samples (mean of " + std::to_string(fr.seeds.size()) + " x " + std::to_string(fr.runs) +
+               " runs)";
+    in.color = out.color = palette(k == 0 ? 0 : k + 1);
+    in.markers = out.markers = true;
+    out.dashed = true;
+    for (const FrontPoint& p : fr.points) {
+      if (p.design.balls != counts[k] || !p.feasible) continue;
+      in.x.push_back(p.design.profile.duration_s());
+      in.y.push_back(metric(p.design.in_sample, "ir_magnitude_mean"));
+      if (oos) {
+        out.x.push_back(p.design.profile.duration_s());
+        out.y.push_back(p.out_of_sample_ir.mean);
+      }
+    }
+    series.push_back(in);
+    if (oos) series.push_back(out);
+  }
+  SvgSeries base;
+  base.name = "baseline, in sample";
+  base.color = "#d62728";
+  base.width = 0;
+  base.x = {f.base.setup.profile.duration_s()};
+  base.y = {metric(r.baseline, "ir_magnitude_mean")};
+  series.push_back(base);
+  if (oos) {
+    SvgSeries b2 = base;
+    b2.name = "baseline, fresh samples";
+    b2.markers = b2.dashed = true;
+    b2.y = {fr.baseline_out_of_sample_ir.mean};
+    series.push_back(b2);
+  }
+  h << "<h2>Pareto front: mean |I<sub>r</sub>| against startup time</h2>\n<figure>"
+    << svg_line_chart("Least mean |I_r| at each bound on the startup time", "startup time T [s]",
+                      "mean |I_r| [1e-7 kg m]", series, 900, 420)
+    << "<figcaption>Stage " << esc(fr.stage) << ": for each bound on T, the study's objective minimised with T &le; the "
+       "bound and the study's other constraints (epsilon-constraint; each bound starts from the previous bound's best). "
+    << (oos ? "Filled dots: in sample (the sample the optimiser chose on, biased low); hollow dots: the same designs and "
+              "the baseline on fresh samples."
+            : "In sample only (the sample the optimiser chose on, biased low): give the stage seeds to check the front "
+              "on fresh samples.")
+    << " Infeasible bounds are left out of the figure.</figcaption></figure>\n";
+  h << "<table><tr><th>bound on T [s]</th><th>balls</th><th>T [s]</th><th>mean |I<sub>r</sub>|<br>in sample</th>"
+    << (oos ? "<th>mean |I<sub>r</sub>|<br>fresh samples</th><th>feasible on<br>every fresh sample</th>" : "")
+    << "<th>%MI</th><th>peak amplitude [mm]</th><th>feasible</th><th>dominated</th><th>profile</th><th>config</th></tr>\n";
+  for (const FrontPoint& p : fr.points) {
+    const StudyDesign& d = p.design;
+    h << "<tr><td class=\"num\">" << sig3(p.bound_s) << "</td><td class=\"num\">" << d.balls << "</td><td class=\"num\">"
+      << sig3(d.profile.duration_s()) << "</td><td class=\"num\">" << sig3(metric(d.in_sample, "ir_magnitude_mean"))
+      << "</td>";
+    if (oos)
+      h << "<td class=\"num\">" << interval_text(p.out_of_sample_ir) << "</td><td>"
+        << (p.feasible_out_of_sample ? "yes" : "no") << "</td>";
+    h << "<td class=\"num\">" << sig3(metric(d.in_sample, "pct_mi")) << "</td><td class=\"num\">"
+      << sig3(metric(d.in_sample, "amplitude_max_mm")) << "</td><td>" << (p.feasible ? "yes" : "no") << "</td><td>"
+      << (p.dominated ? "yes" : "no") << "</td><td class=\"small\">" << esc(profile_text(d.profile))
+      << "</td><td class=\"small\">designs/" << esc(d.label) << ".yaml</td></tr>\n";
+  }
+  h << "<tr><td>baseline</td><td class=\"num\">" << f.base.setup.abu.balls.size() << "</td><td class=\"num\">"
+    << sig3(f.base.setup.profile.duration_s()) << "</td><td class=\"num\">"
+    << sig3(metric(r.baseline, "ir_magnitude_mean")) << "</td>";
+  if (oos) h << "<td class=\"num\">" << interval_text(fr.baseline_out_of_sample_ir) << "</td><td>-</td>";
+  h << "<td class=\"num\">" << sig3(metric(r.baseline, "pct_mi")) << "</td><td class=\"num\">"
+    << sig3(metric(r.baseline, "amplitude_max_mm")) << "</td><td>-</td><td>-</td><td class=\"small\">"
+    << esc(profile_text(f.base.setup.profile)) << "</td><td>-</td></tr>\n</table>\n";
+  return h.str();
+}
+
 }  // namespace
 
 std::string study_html(const StudyFile& f, const StudyResult& r) {
@@ -148,6 +227,9 @@ std::string study_html(const StudyFile& f, const StudyResult& r) {
       << " % of the torus; the balancing positions lie where the residual imbalance vanishes."
          "</figcaption></figure>\n";
   }
+
+  // ---- the Pareto front ----
+  if (!r.front.points.empty()) h << pareto_html(f, r);
 
   // ---- convergence ----
   h << "<h2>Convergence of every stage</h2>\n";

@@ -97,6 +97,85 @@ opt::Evaluation StudyContext::evaluate_profile(const problems::StartupProfileSet
   return e;
 }
 
+OptimiserRun run_archived_optimiser(StudyContext& c, const StageSpec& stage, const std::string& trace_name,
+                                    std::size_t balls, problems::StartupProfileProblem& problem,
+                                    opt::ArchivedProblem& archived, long max_evaluations, const std::vector<double>& x0,
+                                    std::vector<double>& least_violation) {
+  OptimiserRun run;
+  opt::OptimizerOptions o = stage.optimizer;
+  o.max_evaluations = std::min(o.max_evaluations, max_evaluations);
+  const opt::AlgorithmInfo& info = opt::find_algorithm(o.algorithm, "stages." + stage.name + ".optimizer.algorithm");
+  const std::vector<std::string> g_names = problem.inequality_names();
+  std::optional<opt::PenaltyProblem> pen;
+  if (!info.inequality_constraints && !g_names.empty()) pen.emplace(archived, stage.penalty_weight);
+  opt::Problem& p = pen ? static_cast<opt::Problem&>(*pen) : static_cast<opt::Problem&>(archived);
+
+  StageTrace& tr = run.trace;
+  tr.stage = trace_name;
+  tr.balls = balls;
+  double best = std::numeric_limits<double>::infinity();
+  least_violation.resize(g_names.size(), std::numeric_limits<double>::infinity());
+  const opt::EvaluationCallback cb = [&](const opt::Progress& pr) {
+    const opt::EvaluationRecord& rec = pr.last;
+    double obj = rec.objective;
+    std::vector<double> g = rec.inequality;
+    if (pen) {  // the real objective and constraints, from the penalty form's metrics
+      auto it = rec.metrics.find("objective_without_penalty");
+      if (it != rec.metrics.end()) obj = it->second;
+      g.clear();
+      for (const auto& n : g_names) {
+        auto gi = rec.metrics.find("g_" + n);
+        g.push_back(gi == rec.metrics.end() ? kNaN : gi->second);
+      }
+    }
+    bool feas = rec.ok && std::isfinite(obj);
+    for (std::size_t i = 0; i < g.size() && i < g_names.size(); ++i) {
+      if (rec.ok && std::isfinite(g[i])) least_violation[i] = std::min(least_violation[i], g[i]);
+      feas = feas && std::isfinite(g[i]) && g[i] <= kTolerance;
+    }
+    tr.objective.push_back(rec.ok ? obj : kNaN);
+    if (feas && obj < best) {
+      best = obj;
+      run.best_x = rec.x;
+    }
+    tr.best_feasible.push_back(std::isfinite(best) ? best : kNaN);
+    c.tick();
+    return !c.stop();
+  };
+  std::ostringstream head;
+  head << "stage " << trace_name << " (" << balls << " balls): " << o.algorithm << (pen ? " (penalty form)" : "")
+       << ", at most " << o.max_evaluations << " evaluations, from "
+       << (x0.empty() ? "the family's starting point" : "the previous best");
+  c.log(head.str());
+  const opt::OptimizationResult r = opt::minimize(p, o, x0, cb);
+  c.used += r.evaluations;
+  if (r.reason == opt::TerminationReason::Interrupted) c.interrupted = true;
+  tr.algorithm = r.algorithm;
+  tr.reason = to_string(r.reason);
+  tr.evaluations = r.evaluations;
+  tr.archive_hits = r.archive_hits;
+  c.result.evaluations += r.evaluations;
+  c.result.archive_hits += r.archive_hits;
+  run.feasible = !run.best_x.empty();
+  if (run.best_x.empty()) run.best_x = r.x;  // nothing feasible: the optimiser's least bad point
+  return run;
+}
+
+StudyDesign design_at(const ChoiceContext& ch, problems::StartupProfileProblem& problem, opt::ArchivedProblem& archived,
+                      const std::string& label, const std::string& stage, const std::vector<double>& x) {
+  StudyDesign d;
+  d.label = label;
+  d.balls = ch.balls;
+  d.stage = stage;
+  for (const auto& v : problem.variables()) d.variable_names.push_back(v.name);
+  d.x = x;
+  d.profile = problem.profile_at(x);
+  d.in_sample = archived.evaluate(x);  // an archive hit
+  d.robust_feasible = feasible(d.in_sample);
+  d.replicated_objective = d.in_sample.objective;
+  return d;
+}
+
 void run_optimiser_stage(StudyContext& c, const StageSpec& stage, bool from_best) {
   for (ChoiceContext& ch : c.choices) {
     if (c.stop()) return;
@@ -108,75 +187,13 @@ void run_optimiser_stage(StudyContext& c, const StageSpec& stage, bool from_best
       c.log(c.result.notes.back());
       continue;
     }
-    opt::OptimizerOptions o = stage.optimizer;
-    o.max_evaluations = std::min(o.max_evaluations, remaining);
-    const opt::AlgorithmInfo& info = opt::find_algorithm(o.algorithm, "stages." + stage.name + ".optimizer.algorithm");
-    const std::vector<std::string> g_names = ch.problem->inequality_names();
-    std::optional<opt::PenaltyProblem> pen;
-    if (!info.inequality_constraints && !g_names.empty()) pen.emplace(*ch.archived, stage.penalty_weight);
-    opt::Problem& p = pen ? static_cast<opt::Problem&>(*pen) : static_cast<opt::Problem&>(*ch.archived);
-    std::vector<double> x0 = from_best ? ch.x : std::vector<double>{};
-
-    StageTrace tr;
-    tr.stage = stage.name;
-    tr.balls = ch.balls;
-    std::vector<double> best_x;
-    double best = std::numeric_limits<double>::infinity();
-    ch.least_violation.resize(g_names.size(), std::numeric_limits<double>::infinity());
-    const opt::EvaluationCallback cb = [&](const opt::Progress& pr) {
-      const opt::EvaluationRecord& rec = pr.last;
-      double obj = rec.objective;
-      std::vector<double> g = rec.inequality;
-      if (pen) {  // the real objective and constraints, from the penalty form's metrics
-        auto it = rec.metrics.find("objective_without_penalty");
-        if (it != rec.metrics.end()) obj = it->second;
-        g.clear();
-        for (const auto& n : g_names) {
-          auto gi = rec.metrics.find("g_" + n);
-          g.push_back(gi == rec.metrics.end() ? kNaN : gi->second);
-        }
-      }
-      bool feas = rec.ok && std::isfinite(obj);
-      for (std::size_t i = 0; i < g.size() && i < g_names.size(); ++i) {
-        if (rec.ok && std::isfinite(g[i])) ch.least_violation[i] = std::min(ch.least_violation[i], g[i]);
-        feas = feas && std::isfinite(g[i]) && g[i] <= kTolerance;
-      }
-      tr.objective.push_back(rec.ok ? obj : kNaN);
-      if (feas && obj < best) {
-        best = obj;
-        best_x = rec.x;
-      }
-      tr.best_feasible.push_back(std::isfinite(best) ? best : kNaN);
-      c.tick();
-      return !c.stop();
-    };
-    std::ostringstream head;
-    head << "stage " << stage.name << " (" << ch.balls << " balls): " << o.algorithm << (pen ? " (penalty form)" : "")
-         << ", at most " << o.max_evaluations << " evaluations, from "
-         << (x0.empty() ? "the family's starting point" : "the previous best");
-    c.log(head.str());
-    const opt::OptimizationResult r = opt::minimize(p, o, x0, cb);
-    c.used += r.evaluations;
-    if (r.reason == opt::TerminationReason::Interrupted) c.interrupted = true;
-    tr.algorithm = r.algorithm;
-    tr.reason = to_string(r.reason);
-    tr.evaluations = r.evaluations;
-    tr.archive_hits = r.archive_hits;
-    c.result.evaluations += r.evaluations;
-    c.result.archive_hits += r.archive_hits;
-    c.result.traces.push_back(tr);
-    if (best_x.empty()) best_x = r.x;  // nothing feasible: the optimiser's least bad point
-    if (best_x.empty()) continue;     // no evaluation at all (interrupted at once)
-    StudyDesign d;
-    d.label = "balls" + std::to_string(ch.balls) + "_" + stage.name;
-    d.balls = ch.balls;
-    d.stage = stage.name;
-    for (const auto& v : ch.problem->variables()) d.variable_names.push_back(v.name);
-    d.x = best_x;
-    d.profile = ch.problem->profile_at(best_x);
-    d.in_sample = ch.archived->evaluate(best_x);  // an archive hit
-    d.robust_feasible = feasible(d.in_sample);
-    d.replicated_objective = d.in_sample.objective;
+    const std::vector<double> x0 = from_best ? ch.x : std::vector<double>{};
+    OptimiserRun run = run_archived_optimiser(c, stage, stage.name, ch.balls, *ch.problem, *ch.archived, remaining,
+                                              x0, ch.least_violation);
+    c.result.traces.push_back(run.trace);
+    if (run.best_x.empty()) continue;  // no evaluation at all (interrupted at once)
+    const StudyDesign d = design_at(ch, *ch.problem, *ch.archived, "balls" + std::to_string(ch.balls) + "_" + stage.name,
+                                    stage.name, run.best_x);
     // the next stage starts from the best design so far (a stage that found nothing better keeps it)
     const auto better = [](const StudyDesign& a, const StudyDesign& b) {
       const bool fa = feasible(a.in_sample), fb = feasible(b.in_sample);
@@ -185,15 +202,15 @@ void run_optimiser_stage(StudyContext& c, const StageSpec& stage, bool from_best
       return opt::max_constraint_violation(a.in_sample) < opt::max_constraint_violation(b.in_sample);
     };
     if (!ch.last_design || better(d, c.result.designs[*ch.last_design])) {
-      ch.x = best_x;
+      ch.x = run.best_x;
       ch.last_design = c.result.designs.size();
     } else {
       c.log("  not better than " + c.result.designs[*ch.last_design].label + ": the next stage starts from that one");
     }
     c.result.designs.push_back(d);
     std::ostringstream done;
-    done << "  " << tr.reason << " after " << r.evaluations << " evaluations (" << r.archive_hits
-         << " from the archive): objective " << g4(d.in_sample.objective)
+    done << "  " << run.trace.reason << " after " << run.trace.evaluations << " evaluations ("
+         << run.trace.archive_hits << " from the archive): objective " << g4(d.in_sample.objective)
          << (d.robust_feasible ? " (feasible)" : " (NOT feasible)");
     c.log(done.str());
   }
@@ -225,7 +242,10 @@ StudyResult run_study(const StudyFile& f, const StudyRunOptions& o) {
   for (const StageSpec& s : f.stages) {
     if (s.kind == StageKind::Global || s.kind == StageKind::Local)
       optimiser += s.optimizer.max_evaluations * static_cast<long>(f.ball_counts.size());
-    else if (s.kind == StageKind::Replicate)
+    else if (s.kind == StageKind::Pareto) {
+      optimiser += s.optimizer.max_evaluations * static_cast<long>(f.ball_counts.size() * s.pareto_bounds.size());
+      other += static_cast<long>(s.seeds.size() * (f.ball_counts.size() * s.pareto_bounds.size() + 1));
+    } else if (s.kind == StageKind::Replicate)
       other += static_cast<long>(s.seeds.size() * (f.ball_counts.size() + 1));
     else
       other += static_cast<long>(2 * s.seeds.size() + 2 * s.map_friction_mu.size() * s.map_imbalance_factor.size());
@@ -276,6 +296,7 @@ StudyResult run_study(const StudyFile& f, const StudyRunOptions& o) {
       switch (s.kind) {
         case StageKind::Global: run_global_stage(c, s); break;
         case StageKind::Local: run_local_stage(c, s); break;
+        case StageKind::Pareto: run_pareto_stage(c, s); break;
         case StageKind::Replicate:
           run_replicate_stage(c, s);
           replicated = true;

@@ -89,6 +89,13 @@ std::string svg_line_chart(const std::string& title, const std::string& x_label,
     return o.str();
   }
   if (!(x1 > x0)) x1 = x0 + 1;
+  bool dots = false;  // dots at the ends of the x range would be cut by the frame: pad it
+  for (const SvgSeries* s : shown) dots = dots || s->markers || s->width <= 0;
+  if (dots) {
+    const double pad = 0.03 * (x1 - x0);
+    x0 -= pad;
+    x1 += pad;
+  }
   if (!(y1 > y0)) {
     const double pad = std::max(std::fabs(y0) * 0.05, 1e-9);
     y0 -= pad;
@@ -129,13 +136,15 @@ std::string svg_line_chart(const std::string& title, const std::string& x_label,
       pen_up = false;
       ++points;
     }
-    o << "<path d=\"" << d.str() << "\" fill=\"none\" stroke=\"" << s->color << "\" stroke-width=\"" << s->width << "\""
-      << (s->dashed ? " stroke-dasharray=\"6 4\"" : "") << "/>\n";
-    if (points == 1)  // a single point: a dot
+    if (s->width > 0)
+      o << "<path d=\"" << d.str() << "\" fill=\"none\" stroke=\"" << s->color << "\" stroke-width=\"" << s->width << "\""
+        << (s->dashed ? " stroke-dasharray=\"6 4\"" : "") << "/>\n";
+    if (points == 1 || s->markers)  // a single point or markers: a dot at every point
       for (std::size_t i = 0; i < s->x.size(); ++i)
         if (std::isfinite(s->x[i]) && std::isfinite(s->y[i]))
-          o << "<circle cx=\"" << px(X(s->x[i])) << "\" cy=\"" << px(Y(s->y[i])) << "\" r=\"3\" fill=\"" << s->color
-            << "\"/>\n";
+          o << "<circle cx=\"" << px(X(s->x[i])) << "\" cy=\"" << px(Y(s->y[i])) << "\" r=\""
+            << (s->markers ? 4.5 : 3.0) << "\" fill=\"" << (s->dashed && s->markers ? "white" : s->color)
+            << "\" stroke=\"" << s->color << "\" stroke-width=\"1.5\"/>\n";
   }
   // legend below the axis label, in columns
   const double lx0 = L, ly = B + 50;
@@ -146,9 +155,14 @@ std::string svg_line_chart(const std::string& title, const std::string& x_label,
       lx = lx0;
       row += 16;
     }
-    o << "<line x1=\"" << px(lx) << "\" y1=\"" << px(ly + row - 4) << "\" x2=\"" << px(lx + 24) << "\" y2=\""
-      << px(ly + row - 4) << "\" stroke=\"" << s->color << "\" stroke-width=\"" << s->width << "\""
-      << (s->dashed ? " stroke-dasharray=\"6 4\"" : "") << "/><text x=\"" << px(lx + 28) << "\" y=\"" << px(ly + row)
+    if (s->width > 0)
+      o << "<line x1=\"" << px(lx) << "\" y1=\"" << px(ly + row - 4) << "\" x2=\"" << px(lx + 24) << "\" y2=\""
+        << px(ly + row - 4) << "\" stroke=\"" << s->color << "\" stroke-width=\"" << s->width << "\""
+        << (s->dashed ? " stroke-dasharray=\"6 4\"" : "") << "/>";
+    if (s->markers || s->width <= 0)
+      o << "<circle cx=\"" << px(lx + 12) << "\" cy=\"" << px(ly + row - 4) << "\" r=\"4.5\" fill=\""
+        << (s->dashed && s->markers ? "white" : s->color) << "\" stroke=\"" << s->color << "\" stroke-width=\"1.5\"/>";
+    o << "<text x=\"" << px(lx + 28) << "\" y=\"" << px(ly + row)
       << "\">" << xml_escape(s->name) << "</text>\n";
     lx += w;
   }

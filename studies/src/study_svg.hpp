@@ -11,6 +11,7 @@ struct SvgSeries {
   std::string color = "#1f77b4";
   double width = 2.0;
   bool dashed = false;
+  bool markers = false;  // a dot at every point (the line drawn only with width > 0)
 };
 
 // A line chart with axes, ticks, labels and a legend. Series without finite points are left out.

@@ -8,10 +8,20 @@
   study_cli_test.py ABUOPT browser  the tiny study's report.html in headless Chromium: no console
                                     error, every inline figure rendered with a non-zero size
                                     (exit 77 = skipped when chromium is not installed)
+  study_cli_test.py ABUOPT pareto   the tiny study with a pareto stage (two bounds on the startup time,
+                                    its points on fresh samples): every bound's point in summary.json,
+                                    report.md and report.html, T within each bound, the front's mean |I_r|
+                                    not rising as the bound loosens, designs/pareto_T<bound>.yaml, a rerun
+                                    from the archive with the same front
+  study_cli_test.py ABUOPT check    every study file under configs/studies/ (a YAML file with `stages:`
+                                    and `family:`, so files added later are checked too) passes
+                                    `--check` (exit 0, the plan printed, nothing written); bad files fail
+                                    with exit 2 naming the key
   study_cli_test.py ABUOPT quick    configs/studies/quick.yaml end to end (<= 2 min on 2 cores), killed
                                     with SIGKILL part way and resumed, and interrupted with SIGINT and
                                     resumed: the same summary as a run that was never interrupted
 """
+import glob
 import json
 import os
 import re
@@ -256,4 +266,129 @@ def mode_quick():
         shutil.rmtree(tmp, ignore_errors=True)
 
 
-{"tiny": mode_tiny, "browser": mode_browser, "quick": mode_quick}[MODE]()
+def mode_pareto():
+    tmp = tempfile.mkdtemp(prefix="abuopt_study_pareto_")
+    try:
+        text = open(tiny_study(tmp)).read()
+        stage = ("  - {kind: pareto, bounds: [12, 7.5], optimizer: {algorithm: cobyla, max_evaluations: 4, "
+                 "initial_step: 0.1}, seeds: [101, 102], runs: 4}\n")
+        text = text.replace("  - kind: validate", stage + "  - kind: validate")
+        # 4 runs: the peak amplitude against the baseline's is noise; the front is about T
+        text = text.replace("amplitude_vs_baseline: 1.0", "amplitude_vs_baseline: 3.0")
+        study = os.path.join(tmp, "pareto.yaml")
+        open(study, "w").write(text)
+        out = os.path.join(tmp, "p")
+        run(["study", study, "--out", out, "--threads", "1"])
+        s = json.load(open(os.path.join(out, "summary.json")))
+        front = s.get("pareto")
+        if not front or [p["bound_s"] for p in front["points"]] != [7.5, 12]:
+            fail(f"summary.json pareto: {front}")
+        feasible = [p for p in front["points"] if p["feasible"]]
+        if not feasible:
+            fail("no feasible front point (a 12 s bound is loose for this family)")
+        for p in front["points"]:
+            if p["label"] != "pareto_T" + ("7p5" if p["bound_s"] == 7.5 else "12"):
+                fail(f"label {p['label']}")
+            if not os.path.exists(os.path.join(out, p["file"])):
+                fail(f"{p['file']} missing")
+            if p["feasible"] and p["startup_time_s"] > p["bound_s"] * (1 + 1e-9):
+                fail(f"T = {p['startup_time_s']} over the bound {p['bound_s']}")
+            if p["out_of_sample_mean_abs_ir"]["samples"] != 2:
+                fail(f"out of sample: {p['out_of_sample_mean_abs_ir']}")
+            if not (p["evaluations"] <= 4):
+                fail(f"evaluations {p['evaluations']} over the stage's 4")
+        for a, b in zip(feasible, feasible[1:]):  # a looser bound can only do as well or better
+            if b["in_sample"]["metrics"]["ir_magnitude_mean"] > a["in_sample"]["metrics"]["ir_magnitude_mean"] + 1e-12:
+                fail(f"the front rises: {a} then {b}")
+        if front["baseline_out_of_sample_mean_abs_ir"]["samples"] != 2:
+            fail("the baseline out of sample")
+        html = open(os.path.join(out, "report.html")).read()
+        md = open(os.path.join(out, "report.md")).read()
+        if "Pareto front" not in html or "Pareto front" not in md or "pareto_T7p5.yaml" not in md:
+            fail("the front is not in the report")
+        if html.count("<svg") < 4:
+            fail("no front figure")
+        # the design of a front point runs with abuopt montecarlo
+        dtext = open(os.path.join(out, "designs", "pareto_T12.yaml")).read().replace("runs: 4\n", "runs: 2\n")
+        small = os.path.join(tmp, "front_small.yaml")
+        open(small, "w").write(dtext)
+        run(["montecarlo", small, "--out", os.path.join(tmp, "mc")])
+        # a rerun: everything from the archive, the same front
+        run(["study", study, "--out", out, "--threads", "1"])
+        s2 = json.load(open(os.path.join(out, "summary.json")))
+        if s2["archive_hits"] != s2["evaluations"] or comparable(s2) != comparable(s):
+            fail("a rerun from the archive changed the front or computed again")
+        # bad pareto stages: exit 2 naming the key
+        for old, new, want in [("bounds: [12, 7.5]", "bounds: [12, -1]", "stages[3].bounds"),
+                               ("bounds: [12, 7.5]", "bounds: [12, 12]", "each bound may appear once"),
+                               ("{kind: pareto, bounds", "{kind: pareto, over: amplitude, bounds", "stages[3].over = amplitude")]:
+            bad = os.path.join(tmp, "bad.yaml")
+            open(bad, "w").write(text.replace(old, new))
+            p = run(["study", bad, "--check"], expect=2)
+            if want not in p.stderr:
+                fail(f"bad pareto stage ({new}): {p.stderr}")
+        print(f"ok: pareto stage: {len(front['points'])} bounds, {len(feasible)} feasible, in and out of sample, "
+              "rerun from the archive")
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def study_files():
+    """Every `abuopt study` file under configs/studies/ (the `abuopt optimize` configs there have no `stages:`)."""
+    out = []
+    for path in sorted(glob.glob(os.path.join("configs", "studies", "**", "*.yaml"), recursive=True)):
+        text = open(path).read()
+        if re.search(r"^stages:", text, re.M) and re.search(r"^family:", text, re.M):
+            out.append(path)
+    return out
+
+
+def mode_check():
+    files = study_files()
+    if QUICK not in files:
+        fail(f"the glob found {files}, not {QUICK}")
+    tmp = tempfile.mkdtemp(prefix="abuopt_study_check_")
+    try:
+        for path in files:
+            t0 = time.time()
+            p = run(["study", path, "--check", "--out", os.path.join(tmp, "never")])
+            for want in ("the file is valid", "natural frequency f_n", "free variables", "stages:", "budget:",
+                         "estimate: at most"):
+                if want not in p.stdout:
+                    fail(f"--check of {path} lacks '{want}':\n{p.stdout}")
+            if os.path.exists(os.path.join(tmp, "never")):
+                fail(f"--check of {path} wrote its output directory")
+            if time.time() - t0 > 10:
+                fail(f"--check of {path} took {time.time() - t0:.1f} s: it must not simulate")
+        # the quick study's plan: f_n of the report's ABU, bounds converted to Hz, the estimate
+        p = run(["study", QUICK, "--check"])
+        if "f_n = sqrt(k/M)/2pi = 28.89 Hz" not in p.stdout or "f2 in [28.019, 31.774] Hz" not in p.stdout:
+            fail("the quick study's plan:\n" + p.stdout)
+        # 64 runs x (1 baseline + 60 optimiser evaluations) + 3 x 2 x 64 + 2 x 4 x 256 + 2 x 9 x 64 + 2 x 256
+        if "estimate: at most 8,000 simulations" not in p.stdout:
+            fail("the quick study's estimate:\n" + p.stdout)
+        # bounds in Hz that cannot reach f_n: a warning, still exit 0
+        hz = os.path.join(tmp, "hz.yaml")
+        open(hz, "w").write(open(QUICK).read().replace("frequency_unit: natural", "frequency_unit: hz"))
+        p = run(["study", hz, "--check"])
+        if "warning: 2 balls: the family cannot reach the resonance" not in p.stdout:
+            fail("no resonance warning:\n" + p.stdout)
+        # bad files: exit 2, the key, the value and the rule named, as a run says it
+        for old, new, want in [
+                ("kind: validate", "kind: check", "stages[3].kind = check"),
+                ("runs: 64, seed: 21", "runs: -3, seed: 21", "runs = -3"),
+                ("algorithm: direct_l", "algorithm: nosuch", "nosuch"),
+                ("max_pct_mi: 100", "max_pct_mi: 100\n  max_speed: 3", "constraints.max_speed")]:
+            bad = os.path.join(tmp, "bad.yaml")
+            text = open(QUICK).read()
+            assert old in text, old
+            open(bad, "w").write(text.replace(old, new, 1))
+            p = run(["study", bad, "--check"], expect=2)
+            if want not in p.stderr:
+                fail(f"bad file ({new}): the message does not name '{want}':\n{p.stderr}")
+        print(f"ok: --check passes {len(files)} study files ({', '.join(files)}); bad files exit 2 naming the key")
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+{"tiny": mode_tiny, "browser": mode_browser, "quick": mode_quick, "check": mode_check, "pareto": mode_pareto}[MODE]()

@@ -17,6 +17,10 @@
 //              design is the best mean objective among those feasible on every replication
 //   validate   the recommended design and the baseline on fresh, larger samples (intervals over
 //              the seeds), and their ratio over a (mu, imbalance) map of the envelope
+//   pareto     the front of the objective against the startup time T by epsilon-constraint: one
+//              constrained optimisation per bound on T (ascending, each from the previous bound's
+//              best, the first from the best so far), each bound its own archived problem; the
+//              front's points optionally on fresh samples (seeds, runs)
 // Every Monte Carlo goes through one SQLite evaluation archive (OUT/archive.sqlite): a rerun after
 // Ctrl-C or kill -9 recomputes nothing it stored and ends with the same results; results do not
 // depend on the thread count (common random numbers, seeded optimisers).
@@ -35,8 +39,8 @@
 
 namespace abuopt::studies {
 
-enum class StageKind { Global, Local, Replicate, Validate };
-extern const EnumNames<StageKind> kStageKindNames;  // global, local, replicate, validate
+enum class StageKind { Global, Local, Replicate, Validate, Pareto };
+extern const EnumNames<StageKind> kStageKindNames;  // global, local, replicate, validate, pareto
 std::string to_string(StageKind k);
 
 struct StageSpec {
@@ -50,6 +54,8 @@ struct StageSpec {
   std::vector<double> map_friction_mu;
   std::vector<double> map_imbalance_factor;  // x abu.imbalance_mass_kg
   std::size_t map_runs = 0;         // runs per map point (0: the stage's runs)
+  // pareto: the bounds on the startup time T [s], ascending (key `bounds`; `over: startup_time`)
+  std::vector<double> pareto_bounds;
 };
 
 struct RelativeConstraints {
@@ -85,6 +91,18 @@ problems::StartupProfileSettings settings_of_choice(const StudyFile& f, std::siz
 // Which free end frequencies can reach f_n (Hz); empty message when one can.
 std::string resonance_reach_text(const problems::ProfileDesign& d, double natural_frequency_hz);
 
+// The plan of a study (`abuopt study FILE --check`): counts from the file alone, nothing simulated.
+struct StudyPlan {
+  long long runs_per_evaluation = 0;    // sampling.runs x the robust friction values (if any)
+  long long optimiser_evaluations = 0;  // min(the optimiser stages' budgets x choices, budget.max_evaluations)
+  long long simulations = 0;            // an upper estimate of the simulations of the whole study
+  std::vector<std::string> warnings;    // the family cannot reach the resonance, ...
+};
+StudyPlan plan_of(const StudyFile& f);
+// The plan as text for a person: f_n, the free variables with bounds in Hz (after natural units),
+// the choices, each stage with its optimiser and budget, runs per evaluation, the estimate, warnings.
+std::string plan_text(const StudyFile& f);
+
 // One evaluated design (a point of one stage).
 struct StudyDesign {
   std::string label;          // "balls2_local" ...
@@ -116,6 +134,24 @@ struct Interval {
 };
 Interval interval_of(const std::vector<double>& values);
 
+// One point of the Pareto front (pareto stage): the best design with T <= bound.
+struct FrontPoint {
+  double bound_s = 0.0;          // the bound on the startup time
+  StudyDesign design;            // label pareto_T<bound> (balls<n>_pareto_T<bound> with several choices)
+  bool feasible = false;         // in sample, under T <= bound and the study's other constraints
+  bool dominated = false;        // another feasible point of the same choice is no worse in T and mean |I_r|, better in one
+  long evaluations = 0, archive_hits = 0;
+  Interval out_of_sample_ir;     // mean |I_r| on the stage's fresh samples (samples = 0: none)
+  bool feasible_out_of_sample = false;  // on every fresh sample
+};
+struct ParetoFront {
+  std::string stage;             // the stage's name (empty: no pareto stage ran)
+  std::size_t runs = 0;          // runs per fresh sample
+  std::vector<std::uint64_t> seeds;
+  std::vector<FrontPoint> points;  // per choice, in order of the bounds
+  Interval baseline_out_of_sample_ir;  // the baseline on the same fresh samples
+};
+
 struct ValidationResult {
   bool done = false;
   std::size_t runs = 0;
@@ -145,6 +181,7 @@ struct StudyResult {
   std::optional<std::size_t> recommended;      // index into designs
   std::vector<StageTrace> traces;
   ValidationResult validation;
+  ParetoFront front;
 };
 
 struct StudyRunOptions {
