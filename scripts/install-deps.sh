@@ -21,7 +21,7 @@ packages=(
   gnuplot-nox            # plots (optional at run time: studies skip plots without it)
   doxygen                # the optional API reference target `doc` (cmake/AbuoptData.cmake)
   clang libclang-rt-14-dev  # libFuzzer targets (fuzz/, scripts/fuzz.sh) with ASan/UBSan runtimes
-  python3                # scripts/startup_study.py (standard library only)
+  python3                # scripts/robust_evidence.py, benchmarks_report.py (standard library only)
   python3-dev pybind11-dev python3-numpy  # the Python module abuopt (python/; skipped without them)
   python3-scipy python3-matplotlib        # examples/python (each says so and exits 0 without its package)
   chromium               # headless browser: the test that opens abuopt study's report.html (tests/app/study_cli_test.py)

@@ -96,7 +96,7 @@ TEST(SimulateCli, HelpExplainsTheCommand) {
 // The study's ready-to-run designs carry a montecarlo section (for `abuopt montecarlo`); simulate
 // checks it and runs the profile; a bad key in it is still an error naming the key.
 TEST(SimulateCli, RunsConfigsWithAMontecarloSection) {
-  const Result r = run("simulate " + kConfigs + "studies/best/best_19s_nocontact.yaml --beta0 0.5,3.0 --json");
+  const Result r = run("simulate " + kConfigs + "designs/two_balls_19s.yaml --beta0 0.5,3.0 --json");
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(nlohmann::json::parse(r.output)["status"], "ok");
   const std::string bad = write_config("simulate_bad_mc.yaml", "montecarlo: {runz: 3}\n");
@@ -105,17 +105,16 @@ TEST(SimulateCli, RunsConfigsWithAMontecarloSection) {
   EXPECT_NE(b.output.find("montecarlo.runz"), std::string::npos) << b.output;
 }
 
-// Every shipped design (configs/designs/ and what configs/studies/best/ still holds; issue 10: "abuopt simulate and abuopt
-// montecarlo run it as it is") runs unchanged: simulate with the command its header documents, and a Monte Carlo of 4 random
+// Every shipped design (configs/designs/; issue 10: "abuopt simulate and abuopt montecarlo run it as
+// it is") runs unchanged: simulate with the command its header documents, and a Monte Carlo of 4 random
 // starts whose runs all end ok (the designs were validated on 1024; a config that no longer parses
 // or a profile that no longer simulates fails here).
 TEST(SimulateCli, EveryShippedStudyDesignRunsWithSimulateAndMontecarlo) {
   std::vector<std::string> files;
-  for (const char* dir : {"designs", "studies/best"})
-    for (const auto& e : std::filesystem::directory_iterator(kConfigs + dir))
-      if (e.path().extension() == ".yaml") files.push_back(e.path().string());
+  for (const auto& e : std::filesystem::directory_iterator(kConfigs + "designs"))
+    if (e.path().extension() == ".yaml") files.push_back(e.path().string());
   std::sort(files.begin(), files.end());
-  ASSERT_GE(files.size(), 10u);  // the study ships one design per formulation and the front
+  ASSERT_GE(files.size(), 10u);  // the catalogue, configs/designs/README.md
   for (const std::string& f : files) {
     // The command the config documents in its header ("abuopt simulate THIS.yaml --beta0 ..."), as it is.
     std::ifstream in(f);

@@ -258,7 +258,7 @@ TEST(BallContact, ABallStoppedBehindASlowChainIsNotRejoinedAtEveryStop) {
 }
 
 // The three runs of the feed-forward PI + 1 Hz design that ended at the chatter limit (docs/model.md
-// 11.12; contact model version 5, shipped config contact_best_19s_deep_6balls_pi1hz.yaml, mu 0.02:
+// 11.12; contact model version 5, tests/core/data/deep_6balls_pi1hz_setpoints.yaml, mu 0.02:
 // run 893 of seed 9001, runs 50 and 578 of seed 9002, random design, 1024 runs). A whole-Hz setpoint
 // step released a stuck two-ball cluster backward; its stop inside the first step was missed and the
 // choice, with the W' of the modes before the event, kept choosing an inconsistent mode: a 4-event
@@ -268,7 +268,7 @@ TEST(BallContact, ABallStoppedBehindASlowChainIsNotRejoinedAtEveryStop) {
 // scratch builds of 11.12; tolerance 0.05e-7).
 TEST(BallContact, APiSetpointStepThatReleasesAClusterDoesNotChatter) {
   const std::string cfg =
-      std::string(ABUOPT_SOURCE_DIR) + "/configs/studies/best/contact_best_19s_deep_6balls_pi1hz.yaml";
+      std::string(ABUOPT_SOURCE_DIR) + "/tests/core/data/deep_6balls_pi1hz_setpoints.yaml";
   YamlReader root = YamlReader::load_file(cfg);
   const Simulator sim(read_simulation_setup(root));
   ASSERT_EQ(sim.setup().motor.kind, MotorKind::PI);

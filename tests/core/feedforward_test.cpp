@@ -18,7 +18,8 @@ using namespace abuopt;
 
 namespace {
 
-// The deep six-ball design's profile (configs/studies/best/contact_best_19s_deep_6balls.yaml, as written).
+// The deep six-ball design's profile (contact_best_19s_deep_6balls.yaml, as written; git show
+// e47fec4:configs/studies/best/contact_best_19s_deep_6balls.yaml).
 StartupProfile deep_6balls() {
   return StartupProfile({{26.30880504, 1.891213032},
                          {28.9422839, 4.88322},
@@ -80,8 +81,8 @@ std::string error_of(const std::string& yaml) {
 
 }  // namespace
 
-// scripts/pi_feedforward.py on configs/studies/best/contact_best_19s_deep_6balls.yaml (its
-// setpoint() with the defaults: 0.01 s, 100 RK4 substeps, the report's drive), printed with repr.
+// scripts/pi_feedforward.py on deep_6balls() above (its setpoint() with the defaults: 0.01 s,
+// 100 RK4 substeps, the report's drive), printed with repr.
 TEST(FeedForward, MatchesTheScriptItReplaces) {
   const StartupProfile sp = feedforward_setpoint(deep_6balls(), ff_pi());
   ASSERT_EQ(sp.segments().size(), 1886u);

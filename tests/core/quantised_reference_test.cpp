@@ -15,7 +15,8 @@ namespace {
 
 constexpr double kTwoPi = 2.0 * M_PI;
 
-// configs/studies/best/best_19s_nocontact.yaml's profile (rounded as written there).
+// The profile of best_19s_nocontact.yaml (rounded as written there; git show
+// e47fec4:configs/studies/best/best_19s_nocontact.yaml).
 StartupProfile best_19s() {
   return StartupProfile({{27.0045, 1.95963}, {28.9248, 3.65881}, {28.9248, 4.64546}, {100, 8.50797}}, 0.0);
 }
