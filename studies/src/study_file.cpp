@@ -403,8 +403,11 @@ std::string resonance_reach_text(const problems::ProfileDesign& d, double fn) {
   bool any_free = false;
   for (std::size_t i = 0; i < d.segments.size(); ++i) {
     const auto& seg = d.segments[i];
-    if (seg.hold || !seg.end_frequency_hz.free) continue;
+    if (seg.hold) continue;
     const auto& v = seg.end_frequency_hz;
+    // a fixed end frequency within 2 % of f_n: the family already dwells or passes slowly there
+    if (!v.free && std::abs(v.value - fn) <= 0.02 * fn) return "";
+    if (!v.free) continue;
     if (v.lower <= fn && fn <= v.upper) return "";
     ranges << (any_free ? ", " : "") << "f" << i + 1 << " in [" << format_number(v.lower) << ", "
            << format_number(v.upper) << "] Hz";

@@ -133,6 +133,12 @@ TEST(StudyFile, ResonanceOutOfReachIsSaid) {
   EXPECT_NE(note.find("cannot reach the resonance"), std::string::npos) << note;
   EXPECT_NE(note.find("28.9 Hz"), std::string::npos) << note;
   EXPECT_NE(note.find("f2 in [20, 28] Hz"), std::string::npos) << note;
+  // a fixed end frequency at the resonance (here 28.92 Hz, 0.1 % off f_n) is a family that reaches it
+  problems::ProfileDesign fixed_at_fn = s.design;
+  fixed_at_fn.segments.front().end_frequency_hz = {false, 28.92, 0, 0, 0};
+  EXPECT_EQ(resonance_reach_text(fixed_at_fn, 28.9), "");
+  fixed_at_fn.segments.front().end_frequency_hz.value = 27.0;  // 6.6 % off: not
+  EXPECT_NE(resonance_reach_text(fixed_at_fn, 28.9), "");
   // the quick study's own family reaches it
   const StudyFile q = read_study_file(kQuick);
   const auto sq = settings_of_choice(q, 0, {{"amplitude_max_mm", 0.5}});
