@@ -85,6 +85,22 @@ void SaoRun::run(const std::vector<double>& x0) {
   int failures_in_a_row = 0;  // steps rejected or with rho <= rho_shrink
   double streak_radius = radius_;  // the radius before the first of them
   bool polished = false;  // the current trust region has handed over to the polish
+  // Converged with budget left: infill points and a new trust region (docs/sao.md, "Global phase",
+  // restarts). False when there is no restart (the run ends).
+  auto restart_run = [&]() -> bool {
+    if (!restart_wanted()) return false;
+    const long before = driver_.evaluations();
+    const std::optional<bool> restarted = restart();
+    if (!restarted || !*restarted) return false;
+    ++restarts_;
+    last_restart_evaluations_ = before;
+    polished = false;
+    message += "; restart " + std::to_string(restarts_);
+    stalled = 0;
+    failures_in_a_row = 0;
+    streak_radius = radius_;
+    return true;
+  };
   while (true) {
     // the best objective's gains of the last window are within the noise: the trust region has
     // converged as far as the noise lets one tell, and after a restart the run (docs/sao.md,
@@ -95,17 +111,7 @@ void SaoRun::run(const std::vector<double>& x0) {
       message = "the best objective improved by less than " + format_number(sao_.noise_stop) +
                 " noise levels (" + format_number(noise_f_) + ") in " + std::to_string(noise_window()) +
                 " evaluations" + (stall == NoiseStall::Stop ? " after a restart" : "");
-      if (stall == NoiseStall::Stop || !restart_wanted()) return;
-      const long before = driver_.evaluations();
-      const std::optional<bool> restarted = restart();
-      if (!restarted || !*restarted) return;
-      ++restarts_;
-      last_restart_evaluations_ = before;
-      polished = false;
-      message += "; restart " + std::to_string(restarts_);
-      stalled = 0;
-      failures_in_a_row = 0;
-      streak_radius = radius_;
+      if (stall == NoiseStall::Stop || !restart_run()) return;
       continue;
     }
     if (!polished && (radius_ < kPolishRadius || stalled >= sao_.stall_iterations) && polish_wanted()) {
@@ -129,17 +135,7 @@ void SaoRun::run(const std::vector<double>& x0) {
       }
       // converged with budget left: infill points and a new trust region (docs/sao.md, "Global
       // phase", restarts); the result is the best point of the whole run (the driver's)
-      if (!restart_wanted()) return;
-      const long before = driver_.evaluations();
-      const std::optional<bool> restarted = restart();
-      if (!restarted || !*restarted) return;
-      ++restarts_;
-      last_restart_evaluations_ = before;
-      polished = false;
-      message += "; restart " + std::to_string(restarts_);
-      stalled = 0;
-      failures_in_a_row = 0;
-      streak_radius = radius_;
+      if (!restart_run()) return;
       continue;
     }
     if (options_.max_iterations > 0 && iterations >= options_.max_iterations) {
