@@ -157,13 +157,20 @@ opt::Evaluation StartupProfileProblem::evaluate(const std::vector<double>& x) {
                                balls_at(x));
 }
 
-opt::Evaluation StartupProfileProblem::evaluate_out_of_sample_at(const std::vector<double>& x) const {
+// The study's initial-condition design with the validation's kind, grid, run count and seed.
+InitialConditionDesign StartupProfileProblem::validation_design() const {
   const ValidationSettings& v = settings_.validation;
   InitialConditionDesign d = settings_.study.design;
   d.kind = v.design;
   d.grid_points_per_axis = v.grid;
   d.count = v.runs;
   d.seed = v.seed;
+  return d;
+}
+
+opt::Evaluation StartupProfileProblem::evaluate_out_of_sample_at(const std::vector<double>& x) const {
+  const ValidationSettings& v = settings_.validation;
+  const InitialConditionDesign d = validation_design();
   return evaluate_with_threads(profile_at(x), d, v.runs, v.seed, settings_.threads,
                                ball_variable_ ? balls_at(x) : 0);
 }
@@ -211,11 +218,7 @@ opt::Evaluation StartupProfileProblem::evaluate_profile(const StartupProfile& pr
 
 opt::Evaluation StartupProfileProblem::evaluate_out_of_sample(const StartupProfile& profile) const {
   const ValidationSettings& v = settings_.validation;
-  InitialConditionDesign d = settings_.study.design;
-  d.kind = v.design;
-  d.grid_points_per_axis = v.grid;
-  d.count = v.runs;
-  d.seed = v.seed;
+  const InitialConditionDesign d = validation_design();
   return evaluate_profile(profile, d, v.runs, v.seed);
 }
 

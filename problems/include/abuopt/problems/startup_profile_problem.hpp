@@ -277,6 +277,7 @@ class StartupProfileProblem : public opt::Problem {
   std::string validation_identity() const;
 
  private:
+  InitialConditionDesign validation_design() const;
   StartupProfileSettings settings_;
   std::vector<opt::Variable> variables_;
   std::vector<double> x0_;
