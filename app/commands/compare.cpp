@@ -25,6 +25,11 @@
 //     - {label: CMA-ES, algorithm: pagmo_cmaes}             # pagmo2: pagmo_cmaes/xnes/sade/pso
 //     - {label: Optuna-TPE, external: DIR}    # runs made elsewhere: DIR/<problem>/start<k>.csv
 //                                             # (examples/python/optuna_study.py; docs/benchmarks.md)
+//   fronts:                                   # two-objective problems (studies/front_comparison.hpp):
+//     - label: time_vs_imbalance              # NSGA-II against the epsilon-constraint series at equal
+//       reference: {objective: 25, second: 23}  # evaluations, by hypervolume in and out of sample;
+//       methods: [...]                        # fronts.csv, hypervolume.csv, front_<label>.png
+//   (problems and solvers may be left out when fronts are given)
 //
 // Resumable: every run keeps its evaluations in OUT/archive/<problem>/start<k>-<solver>.sqlite (and
 // the validations in OUT/archive/<problem>/validation.sqlite); the same command with the same --out
@@ -47,6 +52,7 @@
 #include "abuopt/optimizer/benchmarking.hpp"
 #include "abuopt/optimizer/benchmarks/benchmark_factory.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
+#include "abuopt/studies/front_comparison.hpp"
 #include "abuopt/parallel/parallel.hpp"
 #include "commands/commands.hpp"
 
@@ -145,6 +151,8 @@ int run_compare(const CompareArgs& a) {
   setup.threads = static_cast<int>(root.get_int_or("threads", setup.threads, Rule::in_range(1, 256)));
   for (YamlReader& p : root.children("problems")) setup.problems.push_back(read_problem(p));
   for (YamlReader& s : root.children("solvers")) setup.solvers.push_back(opt::read_solver_spec(s));
+  std::vector<FrontProblem> fronts;
+  for (YamlReader& f : root.children("fronts")) fronts.push_back(read_front_problem(f));
   root.finish();
   // under mpirun the runs go `threads` at once only if the ranks take studies from several threads;
   // then each run's batches of evaluations are spread too (as in `optimize`)
@@ -152,8 +160,11 @@ int run_compare(const CompareArgs& a) {
     if (!parallel::session()->concurrent_studies()) setup.threads = 1;
     for (opt::SolverSpec& s : setup.solvers) s.options.scheduler = parallel::make_evaluation_scheduler();
   }
-  if (setup.problems.empty()) throw ConfigError("problems", "<missing>", "must list at least one problem");
-  if (setup.solvers.empty()) throw ConfigError("solvers", "<missing>", "must list at least one solver");
+  if (setup.problems.empty() && fronts.empty())
+    throw ConfigError("problems", "<missing>", "must list at least one problem (or a two-objective one under fronts)");
+  if (setup.solvers.empty() && !setup.problems.empty())
+    throw ConfigError("solvers", "<missing>", "must list at least one solver");
+  const bool single = !setup.problems.empty();
 
   std::size_t total = 0;
   for (const auto& p : setup.problems) total += static_cast<std::size_t>(p.starts) * setup.solvers.size();
@@ -189,17 +200,48 @@ int run_compare(const CompareArgs& a) {
     bar.update(ended);
   };
   const StopScope stop_scope;  // SIGINT / SIGTERM end every run after its current evaluation
-  const opt::ComparisonResult result = opt::run_comparison(setup);
+  const opt::ComparisonResult result = single ? opt::run_comparison(setup) : opt::ComparisonResult{};
   bar.finish();
+  // the two-objective problems: after the single-objective ones, their runs archived under
+  // OUT/archive/fronts/ (resumable alike)
+  FrontComparison front_result;
+  if (!fronts.empty() && !stop_requested()) {
+    std::size_t front_runs = 0;
+    for (const auto& f : fronts) front_runs += static_cast<std::size_t>(f.seeds) * f.methods.size();
+    ProgressReporter front_bar("compare fronts", "runs", front_runs,
+                               a.progress ? ProgressMode::Always : ProgressMode::Auto);
+    const auto front_started = std::chrono::steady_clock::now();
+    front_result = run_front_comparison(
+        fronts, (std::filesystem::path(setup.archive_directory) / "fronts").string(), setup.threads,
+        [&](const FrontRun& r, std::size_t ended, std::size_t all) {
+          const double elapsed =
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - front_started).count();
+          std::ostringstream line;
+          line << "[front " << ended << "/" << all << "] " << r.problem << " run " << r.run << " " << r.method << ": "
+               << r.evaluations << " evaluations, " << r.points.size() << " front points, hypervolume "
+               << opt::format_number(r.hv_in) << " in sample";
+          if (r.validated)
+            line << ", " << opt::format_number(r.hv_out) << " out of sample (" << r.points_out << " points feasible)";
+          line << "; " << r.reason << "; elapsed " << format_duration(elapsed);
+          if (ended < all)
+            line << ", ETA " << format_duration(elapsed / static_cast<double>(ended) * static_cast<double>(all - ended));
+          front_bar.message(line.str());
+          front_bar.update(ended);
+        });
+    front_bar.finish();
+  }
   if (stop_requested())  // the tables and profiles need every run: none is written
     throw Interrupted("interrupted by " + stop_signal_name() + ": kept " + std::to_string(computed_evaluations) +
                       " computed evaluations in " + setup.archive_directory +
                       "; no result file is written (the comparison needs every run); rerun the same command "
                       "with --out " + out + " to resume");
-  std::cerr << "compare: " << computed_evaluations << " evaluations computed, " << archived_evaluations
-            << " answered from the archive (" << setup.archive_directory << ")\n";
+  if (single)
+    std::cerr << "compare: " << computed_evaluations << " evaluations computed, " << archived_evaluations
+              << " answered from the archive (" << setup.archive_directory << ")\n";
 
-  const opt::WrittenFiles files = opt::write_comparison(result, out);
+  opt::WrittenFiles files;
+  if (single) files = opt::write_comparison(result, out);
+  if (!fronts.empty()) write_front_outputs(front_result, out, files);
 
   if (a.json) {
     nlohmann::json j;
@@ -229,13 +271,28 @@ int run_compare(const CompareArgs& a) {
                            {"validated_objective", r.validation ? number(r.validation->objective) : nlohmann::json()},
                            {"validated_feasible", r.validation ? nlohmann::json(r.validation_feasible) : nlohmann::json()},
                            {"wall_time_s", r.result.wall_time_s}});
+    j["fronts"] = nlohmann::json::array();
+    for (const auto& r : front_result.runs)
+      j["fronts"].push_back({{"problem", r.problem},
+                             {"method", r.method},
+                             {"run", r.run},
+                             {"evaluations", r.evaluations},
+                             {"budget", r.budget},
+                             {"points", r.points.size()},
+                             {"hv_in", number(r.hv_in)},
+                             {"hv_out", r.validated ? number(r.hv_out) : nlohmann::json()},
+                             {"points_out", r.validated ? nlohmann::json(r.points_out) : nlohmann::json()},
+                             {"reason", r.reason}});
     j["files"] = files.files;
     j["skipped_plots"] = files.skipped_plots;
     std::cout << j.dump(2) << "\n";
   } else {
-    std::cout << opt::format_table(result);
-    std::cout << "\nwritten to " << out << "/: runs.csv, convergence.csv, data_profile.csv, performance_profile.csv, "
-                                         "plots.gp";
+    if (single) std::cout << opt::format_table(result);
+    if (!fronts.empty()) std::cout << format_front_table(front_result);
+    std::cout << "\nwritten to " << out << "/: "
+              << (single ? "runs.csv, convergence.csv, data_profile.csv, performance_profile.csv, plots.gp" : "")
+              << (single && !fronts.empty() ? ", " : "")
+              << (fronts.empty() ? "" : "fronts.csv, hypervolume.csv, front_<problem>.gp");
     if (files.skipped_plots.empty()) std::cout << " and the PNG plots (gnuplot " << files.gnuplot << ")\n";
     else std::cout << "\n";
   }

@@ -73,7 +73,7 @@ bool stopped(opt::TerminationReason r) {
 ParetoResult run_pareto(const problems::StartupProfileSettings& base, const opt::OptimizerOptions& options,
                         const ParetoSettings& pareto, const std::string& archive_path,
                         const std::string& command_config, const std::string& config_hash,
-                        const ParetoProgress& progress, bool validate) {
+                        const ParetoProgress& progress, bool validate, const std::vector<double>& x0) {
   if (base.constraints.max_startup_time_s)
     throw ConfigError("constraints.max_startup_time_s", format_number(*base.constraints.max_startup_time_s),
                       "must be absent for a Pareto front: pareto.max_startup_time_s sets it for each point");
@@ -96,7 +96,7 @@ ParetoResult run_pareto(const problems::StartupProfileSettings& base, const opt:
     p.problem_id = problem.identity();
     const opt::EvaluationCallback cb = [&](const opt::Progress& pr) { return progress ? progress(k, n, pr) : true; };
     // From x0, and (warm_start) from the previous bound's best: the better feasible run is kept.
-    p.result = opt::minimize(archived, options, {}, cb);
+    p.result = opt::minimize(archived, options, x0, cb);
     p.evaluations = p.result.evaluations;
     p.starts = 1;
     if (pareto.warm_start && !start.empty() && !stopped(p.result.reason)) {

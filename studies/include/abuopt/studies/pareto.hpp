@@ -71,10 +71,13 @@ using ParetoProgress = std::function<bool(std::size_t, std::size_t, const opt::P
 // Solves every bound (archive at archive_path, shared by all of them; problem ids differ), then,
 // unless interrupted or `validate` is false, the out-of-sample evaluations. `base` must not bound
 // the startup time itself (ConfigError: constraints.max_startup_time_s is set by the series).
+// `x0`: where every bound's first run starts (empty: the design's x0; `abuopt compare`'s fronts give
+// each run of the series a start of its own).
 ParetoResult run_pareto(const problems::StartupProfileSettings& base, const opt::OptimizerOptions& options,
                         const ParetoSettings& pareto, const std::string& archive_path,
                         const std::string& command_config, const std::string& config_hash,
-                        const ParetoProgress& progress = {}, bool validate = true);
+                        const ParetoProgress& progress = {}, bool validate = true,
+                        const std::vector<double>& x0 = {});
 
 // Marks `dominated` among the points with a feasible best (minimising both T and the objective).
 void mark_dominated(std::vector<ParetoPoint>& points);
