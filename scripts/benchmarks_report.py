@@ -9,7 +9,11 @@ comparison's f*) and the design that reached it, then one row per method over it
 in-sample feasible runs, out-of-sample feasible runs, median and spread (min - max) of the best
 in-sample objective and of the out-of-sample objective, and the evaluations until the best feasible
 in-sample value is within 1 % and 2 % of f* (median over all runs, a run that never got there
-counting as infinite; "k/n" of runs got there). Nothing is typed by hand: rerun the comparisons and this script to update the page.
+counting as infinite; "k/n" of runs got there). For every two-objective problem (`fronts:`;
+hypervolume.csv, fronts.csv): one row per method over its runs: runs, median evaluations, median and
+range of the hypervolume in sample and out of sample, front points feasible out of sample / in
+sample; then the points of the front with the largest out-of-sample hypervolume. Nothing is typed
+by hand: rerun the comparisons and this script to update the page.
 """
 import argparse
 import csv
@@ -123,6 +127,58 @@ def report(directory):
     return "\n".join(out)
 
 
+def fronts_report(directory):
+    """The two-objective sections of one compare output directory ("" if it has none)."""
+    path = os.path.join(directory, "hypervolume.csv")
+    if not os.path.exists(path):
+        return ""
+    with open(path, newline="") as f:
+        hv = list(csv.DictReader(f))
+    points = []
+    fpath = os.path.join(directory, "fronts.csv")
+    if os.path.exists(fpath):
+        with open(fpath, newline="") as f:
+            points = list(csv.DictReader(f))
+    out = []
+    for p in dict.fromkeys(r["problem"] for r in hv):
+        rows = [r for r in hv if r["problem"] == p]
+        methods = list(dict.fromkeys(r["method"] for r in rows))
+        runs = len(set(r["run"] for r in rows))
+        validated = all(r["validated"] == "1" for r in rows)
+        out.append(f"### {p} (two objectives)\n")
+        out.append(f"{len(methods)} methods x {runs} runs; budget {rows[0]['budget']} evaluations per run (equal "
+                   f"evaluations: the epsilon-constraint series splits it over its runs); hypervolume of "
+                   f"(mean objective, second objective) against the reference point ({rows[0]['reference_objective']}, "
+                   f"{rows[0]['reference_second']}), larger is better; out of sample: each front point re-evaluated on the "
+                   f"validation set, the infeasible ones dropped; source: `{directory}`.\n")
+        out.append("| method | runs | median evaluations | median hv (in) | range (in) | median hv (out) | range (out) | "
+                   "points feasible out / in sample |")
+        out.append("|" + "---|" * 8)
+        for m in methods:
+            rs = [r for r in rows if r["method"] == m]
+            med_in, spr_in = spread([num(r["hv_in"]) for r in rs])
+            med_out, spr_out = spread([num(r["hv_out"]) for r in rs]) if validated else ("-", "-")
+            evals = statistics.median(int(r["evaluations"]) for r in rs)
+            pin = sum(int(r["points_in"]) for r in rs)
+            pout = sum(int(r["points_out"]) for r in rs) if validated else "-"
+            out.append(f"| {m} | {len(rs)} | {fmt(float(evals), 4)} | {med_in} | {spr_in} | {med_out} | {spr_out} | "
+                       f"{pout}/{pin} |")
+        key = "hv_out" if validated else "hv_in"
+        best = max(rows, key=lambda r: num(r[key]))
+        pts = [q for q in points if q["problem"] == p and q["method"] == best["method"] and q["run"] == best["run"]]
+        out.append(f"\nBest front ({'out of sample' if validated else 'in sample'}): {best['method']} run {best['run']}, "
+                   f"hypervolume {fmt(num(best[key]), 5)}; its points:\n")
+        out.append("| second objective | objective (in) | objective (out) | feasible out of sample | x |")
+        out.append("|" + "---|" * 5)
+        for q in sorted(pts, key=lambda q: num(q["second"])):
+            feas = {"1": "yes", "0": "no"}.get(q["validated_feasible"], "-")
+            out.append(f"| {fmt(num(q['second']), 4)} | {fmt(num(q['objective']), 5)} | "
+                       f"{fmt(num(q['validated_objective']), 5)} | {feas} | "
+                       f"({', '.join(fmt(num(v), 4) for v in q['x'].split())}) |")
+        out.append("")
+    return "\n".join(out)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("dirs", nargs="+", help="abuopt compare output directories")
@@ -149,9 +205,12 @@ def main():
         with open(a.intro) as f:
             parts.append(f.read().rstrip() + "\n")
     for d in a.dirs:
-        if not os.path.exists(os.path.join(d, "runs.csv")):
-            sys.exit(f"{d}: no runs.csv (an abuopt compare output directory?)")
-        parts.append(report(d))
+        has_runs = os.path.exists(os.path.join(d, "runs.csv"))
+        if not has_runs and not os.path.exists(os.path.join(d, "hypervolume.csv")):
+            sys.exit(f"{d}: no runs.csv or hypervolume.csv (an abuopt compare output directory?)")
+        if has_runs:
+            parts.append(report(d))
+        parts.append(fronts_report(d))
     text = "\n".join(parts).rstrip() + "\n"
     if a.out:
         with open(a.out + ".tmp", "w") as f:
