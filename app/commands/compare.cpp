@@ -337,6 +337,8 @@ void register_compare(CLI::App& app) {
       "Compare optimisers (NLopt algorithms, IPOPT, SAO) on benchmark problems from several starts, each\n"
       "with an evaluation budget: a table (solved runs, evaluations to reach tau, best value, feasibility,\n"
       "time), convergence curves, data profiles and performance profiles (CSV, and PNG + PDF with gnuplot).\n"
+      "Two-objective problems (fronts:): NSGA-II against the epsilon-constraint series at equal evaluations,\n"
+      "by hypervolume in and out of sample (fronts.csv, hypervolume.csv, front_<problem>.png).\n"
       "Every evaluation is archived in OUT/archive/: rerunning the same command (same config, same --out or\n"
       "none) after an interruption resumes (stored evaluations are answered from the archive, bit for bit).\n"
       "Exit status: 0 ok, 2 bad input, 3 a solver evaluated no point in any run, 4 an output file could not be written,\n"

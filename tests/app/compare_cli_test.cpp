@@ -113,6 +113,7 @@ TEST(CompareCli, BadConfigIsOneMessageWithExitStatus2) {
            Case{"problems: []\nsolvers:\n  - {algorithm: cobyla}\n", "problems"},
            Case{"problems:\n  - {benchmark: hs071, startup_profile: {}}\nsolvers:\n  - {algorithm: cobyla}\n",
                 "give either benchmark or startup_profile"},
+           Case{"fronts:\n  - {label: f, max_evaluations: 40}\n", "fronts[0].reference = <missing>: is required"},
        }) {
     const std::string cfg = write_config("compare_bad.yaml", c.yaml);
     const Result r = run("compare " + cfg + " --out " + fresh_dir("compare_cli_bad"));
