@@ -19,6 +19,8 @@
 //                         constraints: ...}   # the sections of an `abuopt optimize` config
 //       label: startup_profile       # optional; max_evaluations, starts, seed, ... as above
 //                                    # (see configs/compare/startup_profile.yaml)
+//       validation_checkpoints: 20   # optional: also validate each run's incumbent at 20 evenly spaced
+//                                    # evaluations (OUT/validated_convergence.csv; docs/benchmarks.md)
 //   solvers:
 //     - {label: SAO, algorithm: sao, sao: {...}}
 //     - {label: COBYLA, algorithm: cobyla, options: {...}}   # options: the optimizer: keys
@@ -104,6 +106,11 @@ opt::ProblemSpec read_startup_profile_problem(YamlReader& r) {
     };
   }
   read_run_settings(r, spec);
+  spec.validation_checkpoints =
+      static_cast<int>(r.get_int_or("validation_checkpoints", 0, Rule::in_range(0, 1000)));
+  if (spec.validation_checkpoints > 0 && !spec.validate)
+    throw ConfigError(r.key_path("validation_checkpoints"), std::to_string(spec.validation_checkpoints),
+                      "needs the problem's validation (startup_profile.validation.enabled: true)");
   r.finish();
   return spec;
 }

@@ -313,21 +313,51 @@ ComparisonResult run_comparison(const ComparisonSetup& setup) {
         }
         rec.best_true_objective = best;
         rec.feasible = std::isfinite(best);
-        if (spec.validate && !rec.result.x.empty()) {
-          if (validation_archive) rec.validation = validation_archive->find(rec.result.x);
-          rec.validation_from_archive = rec.validation.has_value();
-          if (!rec.validation) {
+        // out of sample: stored validations answer again (bit for bit), a point is validated once per run
+        std::map<std::vector<double>, std::pair<Evaluation, bool>> validated;  // x -> (value, from archive)
+        auto validate_at = [&](const std::vector<double>& x) -> const std::pair<Evaluation, bool>& {
+          auto it = validated.find(x);
+          if (it != validated.end()) return it->second;
+          std::optional<Evaluation> e;
+          if (validation_archive) e = validation_archive->find(x);
+          const bool stored = e.has_value();
+          if (!e) {
             const auto started = std::chrono::steady_clock::now();
             try {
-              rec.validation = spec.validate(rec.result.x);
+              e = spec.validate(x);
               if (validation_archive)
-                validation_archive->store(
-                    rec.result.x, *rec.validation,
-                    std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
-            } catch (const std::exception& e) {
-              rec.validation = Evaluation::failed(std::string("validation threw: ") + e.what());
+                validation_archive->store(x, *e,
+                                          std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+            } catch (const std::exception& ex) {
+              e = Evaluation::failed(std::string("validation threw: ") + ex.what());
             }
           }
+          return validated.emplace(x, std::make_pair(std::move(*e), stored)).first->second;
+        };
+        if (spec.validate && spec.validation_checkpoints > 0) {
+          // the incumbent (as the convergence curve counts it) at each checkpoint
+          const long budget = spec.max_evaluations, c = spec.validation_checkpoints;
+          const EvaluationRecord* incumbent = nullptr;
+          double incumbent_f = kInf;
+          std::size_t i = 0;
+          for (long j = 1; j <= c; ++j) {
+            const long at = (j * budget + c - 1) / c;
+            for (; i < rec.result.history.size() && rec.result.history[i].index < at; ++i) {
+              const EvaluationRecord& h = rec.result.history[i];
+              if (!h.feasible || !counts_as_problem_value(h, rec.sample_size, setup.true_objective_metric)) continue;
+              const double f = true_objective(h, setup.true_objective_metric);
+              if (f < incumbent_f) incumbent_f = f, incumbent = &h;
+            }
+            if (!incumbent) continue;
+            const Evaluation& e = validate_at(incumbent->x).first;
+            rec.validated_convergence.push_back(
+                {at, e.objective, max_constraint_violation(e), e.ok && is_feasible(e, spec.constraint_tolerance)});
+          }
+        }
+        if (spec.validate && !rec.result.x.empty()) {
+          const auto& v = validate_at(rec.result.x);
+          rec.validation = v.first;
+          rec.validation_from_archive = v.second;
           rec.validation_feasible = is_feasible(*rec.validation, spec.constraint_tolerance);
         }
         out.runs[first_run + t] = std::move(rec);
@@ -508,6 +538,15 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
           << csv_number(c.best) << "," << csv_number(gap) << "\n";
       }
     }
+    f.commit();
+  }
+  if (std::any_of(r.runs.begin(), r.runs.end(), [](const RunRecord& run) { return !run.validated_convergence.empty(); })) {
+    OutFile f(dir / "validated_convergence.csv", written);
+    f << "problem,start,solver,evaluation,validated_objective,validated_max_violation,validated_feasible\n";
+    for (const RunRecord& run : r.runs)
+      for (const ValidatedCheckpoint& c : run.validated_convergence)
+        f << csv_text(run.problem) << "," << run.start << "," << csv_text(run.solver) << "," << c.evaluation << ","
+          << csv_number(c.objective) << "," << csv_number(c.max_violation) << "," << (c.feasible ? 1 : 0) << "\n";
     f.commit();
   }
   const auto t = r.solve_matrix();

@@ -58,6 +58,16 @@ TEST(AdoptSuiteCli, QuickFormRunsEveryMethodAndFeedsTheReport) {
   EXPECT_EQ(lines, 3 * 2 * 7);  // problems x starts x methods
   EXPECT_EQ(validated, lines);  // every run's design checked out of sample
   for (const char* s : {"SAO", "COBYLA", "SBPLX", "CMA-ES", "xNES", "SADE", "PSO"}) EXPECT_EQ(per_solver[s], 6) << s;
+  // two_ball_19s validates each run's incumbent at 4 checkpoints (6, 12, 18, 24 evaluations)
+  std::istringstream checks(read(dir / "validated_convergence.csv"));
+  std::getline(checks, line);
+  int checkpoints = 0;
+  while (std::getline(checks, line)) {
+    ++checkpoints;
+    EXPECT_EQ(line.rfind("two_ball_19s,", 0), 0u) << line;
+  }
+  EXPECT_GE(checkpoints, 2 * 7 * 3);  // a checkpoint before a run's first feasible point is left out
+  EXPECT_LE(checkpoints, 2 * 7 * 4);
 
   // the two-objective problem: hypervolume.csv has a row per method and run, finite and >= 0, each
   // method with a positive hypervolume in and out of sample in some run, and fronts.csv its points
@@ -92,7 +102,8 @@ TEST(AdoptSuiteCli, QuickFormRunsEveryMethodAndFeedsTheReport) {
   ASSERT_EQ(run("python3 " + src + "/scripts/benchmarks_report.py " + dir.string() + " --out " + md.string()), 0);
   const std::string text = read(md);
   for (const char* p : {"### two_ball_19s", "### two_ball_envelope", "### ball_count_19s", "| PSO |", "| SAO |", "evals to 2 %",
-                        "### time_vs_imbalance (two objectives)", "| NSGA-II | 2 |", "| eps-constraint | 2 |", "Best front"})
+                        "evals to 2 % (out)", "measured out of sample", "### time_vs_imbalance (two objectives)",
+                        "| NSGA-II | 2 |", "| eps-constraint | 2 |", "Best front"})
     EXPECT_NE(text.find(p), std::string::npos) << p << "\n" << text;
   fs::remove_all(dir);
 }

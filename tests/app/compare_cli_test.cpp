@@ -113,6 +113,9 @@ TEST(CompareCli, BadConfigIsOneMessageWithExitStatus2) {
            Case{"problems: []\nsolvers:\n  - {algorithm: cobyla}\n", "problems"},
            Case{"problems:\n  - {benchmark: hs071, startup_profile: {}}\nsolvers:\n  - {algorithm: cobyla}\n",
                 "give either benchmark or startup_profile"},
+           // the out-of-sample trajectory needs a validated (startup_profile) problem
+           Case{"problems:\n  - {benchmark: hs071, validation_checkpoints: 4}\nsolvers:\n  - {algorithm: cobyla}\n",
+                "validation_checkpoints"},
            Case{"fronts:\n  - {label: f, max_evaluations: 40}\n", "fronts[0].reference = <missing>: is required"},
        }) {
     const std::string cfg = write_config("compare_bad.yaml", c.yaml);

@@ -2,11 +2,13 @@
 // case, the "solved" test, and a small end-to-end comparison with its files.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/optimizer/benchmarking.hpp"
@@ -313,6 +315,61 @@ TEST(Comparison, ValidatesEveryResultAndCountsSimulations) {
                        opt::format_number(r.runs[0].validation->objective) + ","),
             std::string::npos)
       << first;
+  std::filesystem::remove_all(dir);
+}
+
+// The out-of-sample trajectory (ProblemSpec::validation_checkpoints): at evaluations ceil(j B / C)
+// the incumbent so far (the best feasible value that counts, as the convergence curve) is validated,
+// each distinct point once per run, and validated_convergence.csv lists the checkpoints.
+TEST(Comparison, ValidatesTheIncumbentAtCheckpoints) {
+  opt::ComparisonSetup setup;
+  opt::ProblemSpec spec;
+  spec.label = "sampled_hs071";
+  spec.make = sampled_noisy_hs071;
+  spec.max_evaluations = 30;
+  spec.validation_checkpoints = 4;  // at 8, 15, 23, 30
+  spec.constraint_tolerance = 1e-2;
+  std::map<std::vector<double>, int> calls;
+  spec.validate = [&calls](const std::vector<double>& x) {
+    ++calls[x];
+    return opt::benchmarks::make_benchmark("hs071")->evaluate(x);
+  };
+  setup.problems.push_back(spec);
+  setup.solvers.push_back(opt::solver_spec("COBYLA", "cobyla"));
+  const opt::ComparisonResult r = opt::run_comparison(setup);
+  ASSERT_EQ(r.runs.size(), 1u);
+  const opt::RunRecord& run = r.runs[0];
+  auto clean = opt::benchmarks::make_benchmark("hs071");
+  std::vector<long> at;
+  for (const opt::ValidatedCheckpoint& c : run.validated_convergence) {
+    at.push_back(c.evaluation);
+    // the incumbent after c.evaluation evaluations, recomputed from the history
+    // (by the true objective: the noisy benchmark reports it as the metric noise_free_objective)
+    const opt::EvaluationRecord* best = nullptr;
+    auto f = [](const opt::EvaluationRecord& h) { return h.metrics.at("noise_free_objective"); };
+    for (const auto& h : run.result.history)
+      if (h.index < c.evaluation && h.feasible && (!best || f(h) < f(*best))) best = &h;
+    ASSERT_NE(best, nullptr);
+    const opt::Evaluation e = clean->evaluate(best->x);
+    EXPECT_EQ(c.objective, e.objective);
+    EXPECT_EQ(c.feasible, opt::is_feasible(e, 1e-2));
+  }
+  // a checkpoint before the first feasible point is left out; the ones kept are the last of the grid
+  const std::vector<long> grid{8, 15, 23, 30};
+  ASSERT_FALSE(at.empty());
+  EXPECT_TRUE(std::equal(at.rbegin(), at.rend(), grid.rbegin()));
+  for (const auto& [x, n] : calls) EXPECT_EQ(n, 1);  // each point validated once, the final result included
+  EXPECT_EQ(run.validation->objective, clean->evaluate(run.result.x).objective);
+  const std::string dir = std::string(ABUOPT_BINARY_DIR) + "/benchmarking_checkpoints_out";
+  std::filesystem::remove_all(dir);
+  opt::write_comparison(r, dir, /*make_plots=*/false);
+  std::ifstream f(std::filesystem::path(dir) / "validated_convergence.csv");
+  std::string line;
+  std::getline(f, line);
+  EXPECT_EQ(line, "problem,start,solver,evaluation,validated_objective,validated_max_violation,validated_feasible");
+  std::size_t rows = 0;
+  while (std::getline(f, line)) ++rows;
+  EXPECT_EQ(rows, run.validated_convergence.size());
   std::filesystem::remove_all(dir);
 }
 

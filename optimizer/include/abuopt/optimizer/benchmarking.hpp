@@ -98,6 +98,12 @@ struct ProblemSpec {
   // design, runs and seed), so a changed validation never answers from values stored for another.
   // Empty: the identity alone keys them (a validate() that the identity fixes).
   std::string validation_identity;
+  // Checkpoints of the out-of-sample trajectory (needs validate; 0: none): at evaluations
+  // ceil(j max_evaluations / C), j = 1..C, the run's incumbent so far (its best feasible value that
+  // counts, as the convergence curve) is validated too (RunRecord::validated_convergence), so the
+  // evaluations a method needs to come within x % of the best design OUT of sample can be read off
+  // (a sampled problem's in-sample values fit its own runs: their best is no reference).
+  int validation_checkpoints = 0;
 };
 
 struct RunRecord;
@@ -135,6 +141,14 @@ struct ConvergencePoint {
   double best = 0.0;
 };
 
+// The run's incumbent after `evaluation` evaluations, validated (ProblemSpec::validation_checkpoints).
+struct ValidatedCheckpoint {
+  long evaluation = 0;
+  double objective = 0.0;      // out of sample
+  double max_violation = 0.0;  // out of sample
+  bool feasible = false;       // out of sample, within the run's tolerance
+};
+
 struct RunRecord {
   std::string problem;
   std::string solver;
@@ -151,6 +165,7 @@ struct RunRecord {
   std::optional<Evaluation> validation;
   bool validation_feasible = false;
   bool validation_from_archive = false;  // the validation was answered by the archive
+  std::vector<ValidatedCheckpoint> validated_convergence;  // ProblemSpec::validation_checkpoints; in order
 };
 
 struct ComparisonResult {
