@@ -48,7 +48,10 @@ std::vector<std::string> methods_of(const FrontProblem& fp) {
 
 std::string x_text(const std::vector<double>& x) {
   std::string s;
-  for (double v : x) s += (s.empty() ? "" : " ") + format_number(v);
+  for (double v : x) {
+    if (!s.empty()) s += ' ';
+    s += format_number(v);
+  }
   return s;
 }
 
