@@ -132,8 +132,10 @@ def report(directory):
         head = ("| method | feasible in / out of sample | median best f (in) | spread (in) | median f (out) | "
                 "spread (out) | median f (out, all runs) | median gap (out) | "
                 f"evals to 1 % {where_evals} | evals to 2 % {where_evals} |")
+        if not validated:  # nothing out of sample: the in-sample columns only
+            head = ("| method | feasible | median best f | spread | evals to 1 % | evals to 2 % |")
         out.append(head)
-        out.append("|" + "---|" * 10)
+        out.append("|" + "---|" * (10 if validated else 6))
         for s in solvers:
             rs = [r for r in rows if r["solver"] == s]
             n = len(rs)
@@ -160,8 +162,10 @@ def report(directory):
             outs = [num(r["validated_objective"]) for r in rs if r.get("validated_feasible") == "1"]
             if outs and math.isfinite(best_out):
                 gap = f"{100 * (statistics.median(outs) - best_out) / max(abs(best_out), 1e-300):.1f} %"
-            out.append(f"| {s} | {feas_in}/{n} / {feas_out if validated else '-'}/{n if validated else '-'} | "
-                       f"{med_in} | {spr_in} | {med_out if validated else '-'} | {spr_out if validated else '-'} | "
+            if not validated:
+                out.append(f"| {s} | {feas_in}/{n} | {med_in} | {spr_in} | {cells[0]} | {cells[1]} |")
+                continue
+            out.append(f"| {s} | {feas_in}/{n} / {feas_out}/{n} | {med_in} | {spr_in} | {med_out} | {spr_out} | "
                        f"{med_all} | {gap} | {cells[0]} | {cells[1]} |")
         out.append("")
     return "\n".join(out)
