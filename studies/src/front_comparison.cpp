@@ -36,8 +36,8 @@ FrontMethod read_method(YamlReader& r, const FrontProblem& fp, std::size_t dimen
   const std::string algorithm = r.get_string("algorithm");
   m.label = r.get_string_or("label", algorithm);
   if (m.label.empty()) throw ConfigError(r.key_path("label"), "\"\"", "must not be empty");
-  if (algorithm == "pagmo_nsga2") {
-    m.kind = FrontMethod::Kind::Nsga2;
+  if (algorithm == "pagmo_nsga2" || algorithm == "pagmo_moead") {
+    m.kind = algorithm == "pagmo_moead" ? FrontMethod::Kind::Moead : FrontMethod::Kind::Nsga2;
     YamlReader options = r.child("options");
     if (options.present()) {
       if (options.has("algorithm"))
@@ -46,14 +46,15 @@ FrontMethod read_method(YamlReader& r, const FrontProblem& fp, std::size_t dimen
       m.options = opt::read_optimizer_options(options);
     }
     m.options.population = r.get_int_or("population", m.options.population > 0 ? m.options.population : 20,
-                                        Rule::in_range(8, 100000));
-    if (m.options.population % 4 != 0)
+                                        Rule::in_range(4, 100000));
+    const char* name = m.kind == FrontMethod::Kind::Moead ? "MOEA/D" : "NSGA-II";
+    if (m.kind == FrontMethod::Kind::Nsga2 && (m.options.population < 8 || m.options.population % 4 != 0))
       throw ConfigError(r.key_path("population"), std::to_string(m.options.population),
-                        "NSGA-II needs a multiple of 4");
+                        "NSGA-II needs a multiple of 4, at least 8");
     if (m.options.population > fp.max_evaluations)
       throw ConfigError(r.key_path("population"), std::to_string(m.options.population),
-                        "must be <= max_evaluations (" + std::to_string(fp.max_evaluations) +
-                            "): NSGA-II needs at least one population");
+                        "must be <= max_evaluations (" + std::to_string(fp.max_evaluations) + "): " + name +
+                            " needs at least one population");
   } else if (algorithm == "epsilon_constraint") {
     m.kind = FrontMethod::Kind::EpsilonConstraint;
     if (fp.second_objective != "startup_time_s")
@@ -90,7 +91,7 @@ FrontMethod read_method(YamlReader& r, const FrontProblem& fp, std::size_t dimen
                             std::to_string(dimension + 2) + " (fewer bounds, warm_start: false or a larger budget)");
   } else {
     throw ConfigError(r.key_path("algorithm"), algorithm,
-                      "a two-objective method is pagmo_nsga2 or epsilon_constraint");
+                      "a two-objective method is pagmo_nsga2, pagmo_moead or epsilon_constraint");
   }
   r.finish();
   return m;
@@ -184,7 +185,7 @@ opt::OptimizerOptions run_options(const FrontProblem& fp, const FrontMethod& m, 
   return o;
 }
 
-void run_nsga2(const FrontProblem& fp, const FrontMethod& m, const std::vector<double>& x0, int k, int threads,
+void run_pagmo(const FrontProblem& fp, const FrontMethod& m, const std::vector<double>& x0, int k, int threads,
                const std::string& archive_path, FrontRun& run) {
   problems::StartupProfileProblem problem(fp.settings);
   std::unique_ptr<opt::EvaluationArchive> archive;
@@ -195,7 +196,9 @@ void run_nsga2(const FrontProblem& fp, const FrontMethod& m, const std::vector<d
   }
   opt::Problem& target = archived ? static_cast<opt::Problem&>(*archived) : problem;
   const opt::OptimizerOptions o = run_options(fp, m, fp.max_evaluations, k, threads);
-  const opt::TwoObjectiveResult r = opt::minimize_two_objectives(target, fp.second_objective, o, x0);
+  const opt::TwoObjectiveResult r = opt::minimize_two_objectives(
+      target, fp.second_objective, o, x0,
+      m.kind == FrontMethod::Kind::Moead ? opt::TwoObjectiveMethod::Moead : opt::TwoObjectiveMethod::Nsga2);
   run.evaluations = r.run.evaluations;
   run.reason = opt::to_string(r.run.reason);
   for (std::size_t i : r.front) {
@@ -282,7 +285,7 @@ FrontComparison run_front_comparison(
           dir.empty() ? std::string() : (dir / ("run" + std::to_string(k) + "-" + file_safe(m.label) + ".sqlite")).string();
       const auto started = std::chrono::steady_clock::now();
       try {
-        if (m.kind == FrontMethod::Kind::Nsga2) run_nsga2(fp, m, starts[k], k, threads, archive_path, run);
+        if (m.kind != FrontMethod::Kind::EpsilonConstraint) run_pagmo(fp, m, starts[k], k, threads, archive_path, run);
         else run_epsilon_constraint(fp, m, starts[k], k, threads, archive_path, run);
       } catch (const std::exception& e) {  // recorded, never fatal to the other runs
         run.points.clear();
