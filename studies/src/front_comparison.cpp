@@ -108,6 +108,40 @@ long epsilon_constraint_inner_budget(long budget, std::size_t bounds, bool warm_
   return runs == 0 ? 0 : budget / static_cast<long>(runs);
 }
 
+FrontProblem pareto_front_problem(const problems::StartupProfileSettings& base, const opt::OptimizerOptions& options,
+                                  const ParetoSettings& pareto, const std::string& label) {
+  const bool moead = pareto.method == ParetoSettings::Method::Moead;
+  if (pareto.method == ParetoSettings::Method::EpsilonConstraint)
+    throw ConfigError("pareto.method", "epsilon_constraint", "is run_pareto's series, not a population method");
+  const std::string method = to_string(pareto.method);
+  if (base.constraints.max_startup_time_s)
+    throw ConfigError("constraints.max_startup_time_s", format_number(*base.constraints.max_startup_time_s),
+                      "must be absent for method " + method + ": the startup time is the front's second objective");
+  if (base.constraints.penalty_weight > 0)
+    throw ConfigError("constraints.penalty_weight", format_number(base.constraints.penalty_weight),
+                      "must be 0 for method " + method + ": " + (moead ? "MOEA/D" : "NSGA-II") +
+                          " sees the constraints itself (feasibility rules)");
+  opt::check_two_objective_population(moead ? opt::TwoObjectiveMethod::Moead : opt::TwoObjectiveMethod::Nsga2,
+                                      pareto.population, pareto.max_evaluations, "pareto.population",
+                                      "pareto.max_evaluations");
+  FrontProblem fp;
+  fp.label = label;
+  fp.settings = base;
+  fp.second_objective = "startup_time_s";
+  fp.max_evaluations = pareto.max_evaluations;
+  fp.seeds = 1;
+  fp.seed = options.seed;
+  fp.constraint_tolerance = options.constraint_tolerance;
+  fp.reference = pareto.reference;
+  FrontMethod m;
+  m.kind = moead ? FrontMethod::Kind::Moead : FrontMethod::Kind::Nsga2;
+  m.label = moead ? "MOEA/D" : "NSGA-II";
+  m.options = options;
+  m.options.population = pareto.population;
+  fp.methods.push_back(m);
+  return fp;
+}
+
 FrontProblem read_front_problem(YamlReader& r) {
   FrontProblem fp;
   fp.label = r.get_string("label");

@@ -41,6 +41,7 @@
 #include "abuopt/optimizer/benchmarking.hpp"
 #include "abuopt/optimizer/optimizer_options.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
+#include "abuopt/studies/pareto.hpp"
 
 namespace abuopt {
 
@@ -71,6 +72,15 @@ struct FrontProblem {
 // missing, not > 0 or not beyond the loosest bound, a budget below one NSGA-II population or one
 // that leaves an inner run fewer than dimension + 2 evaluations, duplicate method labels.
 FrontProblem read_front_problem(YamlReader& entry);
+
+// `abuopt pareto` with pareto.method nsga2 or moead: the front as a FrontProblem of one run
+// (label `label`, method "NSGA-II" or "MOEA/D" with pareto.population, budget pareto.max_evaluations,
+// reference pareto.reference, seed and constraint_tolerance from `options`, the run from the
+// design's x0) for run_front_comparison, so its outputs are compare's (fronts.csv, hypervolume.csv,
+// front_<label>.png, every point validated out of sample, archived and resumable). ConfigError: a
+// bound on the startup time or a penalty_weight in `base` (both objectives are the method's own).
+FrontProblem pareto_front_problem(const problems::StartupProfileSettings& base, const opt::OptimizerOptions& options,
+                                  const ParetoSettings& pareto, const std::string& label);
 
 // Runs of the epsilon-constraint series and the budget of each: floor(budget / runs).
 std::size_t epsilon_constraint_runs(std::size_t bounds, bool warm_start);
