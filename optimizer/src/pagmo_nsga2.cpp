@@ -112,7 +112,7 @@ void check_two_objective_population(TwoObjectiveMethod method, long population, 
 
 TwoObjectiveResult minimize_two_objectives(Problem& problem, const std::string& second_objective,
                                            const OptimizerOptions& options, std::vector<double> x0,
-                                           TwoObjectiveMethod method) {
+                                           TwoObjectiveMethod method, const EvaluationCallback& callback) {
   options.validate();
   check_problem(problem);
   if (second_objective.empty())
@@ -125,8 +125,7 @@ TwoObjectiveResult minimize_two_objectives(Problem& problem, const std::string& 
 
   detail::SigintGuard sigint(options.handle_sigint);
   detail::interrupt_flag().store(false);
-  const EvaluationCallback none;
-  detail::EvaluationDriver driver(problem, options, none);
+  detail::EvaluationDriver driver(problem, options, callback);
   const std::size_t n = driver.n();
   Context ctx{&driver, second_objective, options.constraint_tolerance};
   TwoObjectiveResult out;

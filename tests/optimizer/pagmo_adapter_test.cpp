@@ -211,7 +211,9 @@ TEST(TwoObjectives, Nsga2ApproachesTheZdt1Front) {
     EXPECT_GE(hv, 0.97 * exact) << constrained;
     for (std::size_t i : r.front) {
       EXPECT_TRUE(r.run.history[i].feasible);
-      if (constrained) EXPECT_GE(r.run.history[i].x[0], 0.2 - 1e-6);
+      if (constrained) {
+        EXPECT_GE(r.run.history[i].x[0], 0.2 - 1e-6);
+      }
     }
   }
   opt::FunctionProblem p = zdt1(false);

@@ -22,6 +22,7 @@
 #include <utility>
 #include <vector>
 
+#include "abuopt/optimizer/minimize.hpp"
 #include "abuopt/optimizer/optimization_result.hpp"
 #include "abuopt/optimizer/optimizer_options.hpp"
 #include "abuopt/optimizer/problem.hpp"
@@ -49,9 +50,12 @@ void check_two_objective_population(TwoObjectiveMethod method, long population, 
 // ConfigError before any evaluation: second_objective empty, population (default 20) invalid for
 // the method (check_two_objective_population), or a budget below one population. A point whose
 // evaluation lacks the metric counts as failed. options.algorithm is not used (the method is).
+// callback: after every evaluation, as minimize()'s; returning false stops the run
+// (StoppedByCallback; the front is made of what was evaluated).
 TwoObjectiveResult minimize_two_objectives(Problem& problem, const std::string& second_objective,
                                            const OptimizerOptions& options, std::vector<double> x0 = {},
-                                           TwoObjectiveMethod method = TwoObjectiveMethod::Nsga2);
+                                           TwoObjectiveMethod method = TwoObjectiveMethod::Nsga2,
+                                           const EvaluationCallback& callback = {});
 
 // The non-dominated subset of points (both minimised), sorted by the first coordinate.
 std::vector<std::pair<double, double>> non_dominated_2d(std::vector<std::pair<double, double>> points);
