@@ -117,8 +117,8 @@ ParetoResult run_pareto(const problems::StartupProfileSettings& base, const opt:
                         const ParetoProgress& progress, bool validate, const std::vector<double>& x0) {
   if (pareto.method != ParetoSettings::Method::EpsilonConstraint)
     throw ConfigError("pareto.method", to_string(pareto.method),
-                      "run_pareto is the epsilon-constraint series; nsga2 and moead run as a front "
-                      "(pareto_front_problem, run_front_comparison: `abuopt pareto`)");
+                      "this runs the epsilon-constraint series only; methods nsga2 and moead run with the command "
+                      "`abuopt pareto` (in C++: pareto_front_problem and run_front_comparison)");
   if (base.constraints.max_startup_time_s)
     throw ConfigError("constraints.max_startup_time_s", format_number(*base.constraints.max_startup_time_s),
                       "must be absent for a Pareto front: pareto.max_startup_time_s sets it for each point");
