@@ -23,6 +23,7 @@
 #include "abuopt/optimizer/minimize.hpp"
 #include "abuopt/optimizer/optimizer_options.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
+#include "abuopt/studies/front_comparison.hpp"
 #include "abuopt/studies/pareto.hpp"
 #include "abuopt/studies/sweep.hpp"
 #include "commands/commands.hpp"
@@ -49,25 +50,123 @@ nlohmann::json evaluation_json(const opt::Evaluation& e) {
   return j;
 }
 
+// pareto.method nsga2 / moead: one run of pagmo's method on both objectives, through compare's
+// fronts machinery (front_comparison.hpp): fronts.csv, hypervolume.csv, front_<stem>.png,
+// summary.json; archive OUT/archive/<stem>/ (a rerun resumes).
+int run_population_front(const ParetoArgs& a, const problems::StartupProfileSettings& settings,
+                         const opt::OptimizerOptions& options, const ParetoSettings& ps) {
+  const std::string label = fs::path(a.config).stem().string();
+  const FrontProblem fp = pareto_front_problem(settings, options, ps, label);
+  const problems::StartupProfileProblem shape(settings);  // validates; names
+  const auto vars = shape.variables();
+  const fs::path out = a.out.empty() ? fs::path("results") / fs::path(a.config).stem() : fs::path(a.out);
+  const OutputDirLock lock(out);
+  const Provenance prov = provenance_of(a.config);
+  std::ostream& log = a.json ? std::cerr : std::cout;
+  const FrontMethod& m = fp.methods.front();
+  log << "pareto " << a.config << ": " << m.label << " (population " << ps.population << ", seed " << fp.seed << ") on "
+      << objective_label(settings) << " and the startup time at once, " << ps.max_evaluations << " evaluations of "
+      << settings.study.runs << " runs each; then every front point out of sample"
+      << (settings.validation.enabled ? " (" + std::to_string(settings.validation.runs) + " runs)" : " (validation off)")
+      << "\n  archive " << (out / "archive").string() << "/ (a rerun resumes)\n"
+      << std::flush;
+  const StopScope stop_scope;  // SIGINT / SIGTERM end the run after the current evaluation or batch
+  const FrontComparison c = run_front_comparison({fp}, (out / "archive").string(), 1);
+  const bool interrupted = stop_requested();
+  opt::WrittenFiles written;
+  write_front_outputs(c, out.string(), written);
+  const FrontRun& run = c.runs.front();
+  log << format_front_table(c);
+  log << "\n  T [s]   objective (in)   out of sample   feasible out\n";
+  for (auto it = run.points.rbegin(); it != run.points.rend(); ++it) {  // by T (points are by objective)
+    const FrontPoint& p = *it;
+    if (!p.non_dominated) continue;
+    std::ostringstream os;
+    os << std::fixed << std::setprecision(2) << std::setw(7) << p.second << std::setprecision(4) << std::setw(15)
+       << p.objective;
+    if (p.validation && p.validation->ok)
+      os << std::setw(16) << p.validation->objective << std::setw(12) << (p.validated_feasible ? "yes" : "NO");
+    else
+      os << std::setw(16) << "-" << std::setw(12) << "-";
+    log << os.str() << "\n";
+  }
+
+  nlohmann::json j;
+  j["config"] = a.config;
+  j["provenance"] = {{"abuopt_version", prov.abuopt_version},
+                     {"git_commit", prov.git_commit},
+                     {"config_hash", prov.config_hash}};
+  j["method"] = to_string(ps.method);
+  j["algorithm"] = m.kind == FrontMethod::Kind::Moead ? "pagmo_moead" : "pagmo_nsga2";
+  j["population"] = ps.population;
+  j["seed"] = fp.seed;
+  j["max_evaluations"] = ps.max_evaluations;
+  j["evaluations"] = run.evaluations;
+  j["reason"] = run.reason;
+  j["objective"] = {{"kind", problems::to_string(settings.objective.kind)}, {"label", objective_label(settings)}};
+  j["montecarlo"] = {{"runs", settings.study.runs}, {"seed", settings.study.seed}};
+  j["validation"] = {{"runs", settings.validation.runs}, {"seed", settings.validation.seed}};
+  j["reference"] = {{"objective", ps.reference.first}, {"startup_time_s", ps.reference.second}};
+  j["hypervolume"] = {{"in_sample", run.hv_in},
+                      {"out_of_sample", run.validated ? nlohmann::json(run.hv_out) : nlohmann::json()}};
+  nlohmann::json pts = nlohmann::json::array();
+  for (const FrontPoint& p : run.points) {
+    nlohmann::json x = nlohmann::json::object();
+    for (std::size_t i = 0; i < vars.size() && i < p.x.size(); ++i) x[vars[i].name] = p.x[i];
+    nlohmann::json q = {{"startup_time_s", p.second}, {"objective", p.objective}, {"non_dominated", p.non_dominated},
+                        {"x", x}};
+    if (p.validation) {
+      q["out_of_sample"] = evaluation_json(*p.validation);
+      q["feasible_out_of_sample"] = p.validated_feasible;
+    }
+    pts.push_back(q);
+  }
+  j["points"] = pts;
+  j["interrupted"] = interrupted;
+  j["files"] = written.files;
+  j["skipped_plots"] = written.skipped_plots;
+  write_file_atomic(out / "summary.json", j.dump(2) + "\n");
+  log << "wrote " << (out / "fronts.csv").string() << ", " << (out / "hypervolume.csv").string() << ", "
+      << (out / "summary.json").string();
+  for (const std::string& f : written.files)
+    if (f.size() > 4 && f.substr(f.size() - 4) == ".png") log << ", " << f;
+  log << "\n";
+  if (a.json) std::cout << j.dump(2) << "\n";
+  if (interrupted) {
+    std::cerr << "abuopt: interrupted by " << stop_signal_name() << ": kept the front so far (fronts.csv, "
+              << "summary.json) and every evaluation in the archive; rerun the same command to resume\n";
+    return stop_exit_status();
+  }
+  return run.points.empty() ? 3 : 0;
+}
+
 int run_pareto_command(const ParetoArgs& a) {
   YamlReader root = YamlReader::load_file(a.config);
   problems::StartupProfileSettings settings = problems::read_startup_profile_settings(root);
+  const ParetoSettings ps = read_pareto_settings(root.child("pareto"));
   YamlReader optimizer = root.child("optimizer");
+  if (ps.method != ParetoSettings::Method::EpsilonConstraint)
+    for (const char* key : {"algorithm", "max_evaluations"})  // the method and its budget are pareto's
+      if (optimizer.has(key))
+        throw ConfigError(optimizer.key_path(key), yaml_value_text(optimizer.node()[key]),
+                          "must be absent with pareto.method " + to_string(ps.method) + ": the method is pareto.method, " +
+                              "its budget pareto.max_evaluations (optimizer gives seed, constraint_tolerance, " +
+                              "evaluation_threads, max_time_s)");
   YamlReader sao = root.child("sao");
   opt::OptimizerOptions options = opt::read_optimizer_options(optimizer, &sao);
-  const ParetoSettings ps = read_pareto_settings(root.child("pareto"));
   finish_config(root);  // the file may also configure `abuopt optimize` and `abuopt sweep`
   options.validate();
+  if (a.threads) {
+    if (*a.threads < 0) throw ConfigError("--threads", std::to_string(*a.threads), "must be >= 0 (0 = all cores)");
+    settings.threads = static_cast<std::size_t>(*a.threads);
+  }
+  if (ps.method != ParetoSettings::Method::EpsilonConstraint) return run_population_front(a, settings, options, ps);
   if (a.max_bounds < 2) throw ConfigError("--max-bounds", std::to_string(a.max_bounds), "must be >= 2");
   if (ps.max_startup_time_s.size() > static_cast<std::size_t>(a.max_bounds))
     throw ConfigError("pareto.max_startup_time_s", std::to_string(ps.max_startup_time_s.size()) + " bounds",
                       "at most " + std::to_string(a.max_bounds) + " bounds in one run (each is an optimisation of up to " +
                           std::to_string(options.max_evaluations) +
                           " evaluations, twice with the warm start); pass --max-bounds N to allow more");
-  if (a.threads) {
-    if (*a.threads < 0) throw ConfigError("--threads", std::to_string(*a.threads), "must be >= 0 (0 = all cores)");
-    settings.threads = static_cast<std::size_t>(*a.threads);
-  }
   const problems::StartupProfileProblem shape(settings);  // validates; names and labels
   const auto vars = shape.variables();
 
@@ -202,6 +301,9 @@ void register_pareto(CLI::App& app) {
       "startup time <= bound, from x0 and from the previous bound's best (the better is kept). Every evaluation is archived\n"
       "in OUT/archive.sqlite (a rerun resumes). Then each front point and the 2003 report's profile on\n"
       "fresh initial conditions (out of sample). Writes pareto.csv, summary.json, pareto.png/.pdf.\n"
+      "pareto.method: nsga2 or moead instead: one run of pagmo's NSGA-II / MOEA/D on both objectives\n"
+      "(pareto.max_evaluations, population, reference), archived in OUT/archive/, every front point out of\n"
+      "sample; writes fronts.csv, hypervolume.csv, front_<config stem>.png, summary.json (docs/sweep.md).\n"
       "Exit status: 0 ok, 2 bad input, 3 no bound gave a feasible design, 4 a file could not be written,\n"
       "130 interrupted (Ctrl-C), 143 terminated (SIGTERM).");
   sub->add_option("config", args->config, "YAML config: the sections of `optimize` plus `pareto` (docs/sweep.md)")

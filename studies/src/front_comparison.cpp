@@ -36,8 +36,8 @@ FrontMethod read_method(YamlReader& r, const FrontProblem& fp, std::size_t dimen
   const std::string algorithm = r.get_string("algorithm");
   m.label = r.get_string_or("label", algorithm);
   if (m.label.empty()) throw ConfigError(r.key_path("label"), "\"\"", "must not be empty");
-  if (algorithm == "pagmo_nsga2") {
-    m.kind = FrontMethod::Kind::Nsga2;
+  if (algorithm == "pagmo_nsga2" || algorithm == "pagmo_moead") {
+    m.kind = algorithm == "pagmo_moead" ? FrontMethod::Kind::Moead : FrontMethod::Kind::Nsga2;
     YamlReader options = r.child("options");
     if (options.present()) {
       if (options.has("algorithm"))
@@ -46,14 +46,15 @@ FrontMethod read_method(YamlReader& r, const FrontProblem& fp, std::size_t dimen
       m.options = opt::read_optimizer_options(options);
     }
     m.options.population = r.get_int_or("population", m.options.population > 0 ? m.options.population : 20,
-                                        Rule::in_range(8, 100000));
-    if (m.options.population % 4 != 0)
+                                        Rule::in_range(4, 100000));
+    const char* name = m.kind == FrontMethod::Kind::Moead ? "MOEA/D" : "NSGA-II";
+    if (m.kind == FrontMethod::Kind::Nsga2 && (m.options.population < 8 || m.options.population % 4 != 0))
       throw ConfigError(r.key_path("population"), std::to_string(m.options.population),
-                        "NSGA-II needs a multiple of 4");
+                        "NSGA-II needs a multiple of 4, at least 8");
     if (m.options.population > fp.max_evaluations)
       throw ConfigError(r.key_path("population"), std::to_string(m.options.population),
-                        "must be <= max_evaluations (" + std::to_string(fp.max_evaluations) +
-                            "): NSGA-II needs at least one population");
+                        "must be <= max_evaluations (" + std::to_string(fp.max_evaluations) + "): " + name +
+                            " needs at least one population");
   } else if (algorithm == "epsilon_constraint") {
     m.kind = FrontMethod::Kind::EpsilonConstraint;
     if (fp.second_objective != "startup_time_s")
@@ -90,7 +91,7 @@ FrontMethod read_method(YamlReader& r, const FrontProblem& fp, std::size_t dimen
                             std::to_string(dimension + 2) + " (fewer bounds, warm_start: false or a larger budget)");
   } else {
     throw ConfigError(r.key_path("algorithm"), algorithm,
-                      "a two-objective method is pagmo_nsga2 or epsilon_constraint");
+                      "a two-objective method is pagmo_nsga2, pagmo_moead or epsilon_constraint");
   }
   r.finish();
   return m;
@@ -105,6 +106,40 @@ std::size_t epsilon_constraint_runs(std::size_t bounds, bool warm_start) {
 long epsilon_constraint_inner_budget(long budget, std::size_t bounds, bool warm_start) {
   const std::size_t runs = epsilon_constraint_runs(bounds, warm_start);
   return runs == 0 ? 0 : budget / static_cast<long>(runs);
+}
+
+FrontProblem pareto_front_problem(const problems::StartupProfileSettings& base, const opt::OptimizerOptions& options,
+                                  const ParetoSettings& pareto, const std::string& label) {
+  const bool moead = pareto.method == ParetoSettings::Method::Moead;
+  if (pareto.method == ParetoSettings::Method::EpsilonConstraint)
+    throw ConfigError("pareto.method", "epsilon_constraint", "is run_pareto's series, not a population method");
+  const std::string method = to_string(pareto.method);
+  if (base.constraints.max_startup_time_s)
+    throw ConfigError("constraints.max_startup_time_s", format_number(*base.constraints.max_startup_time_s),
+                      "must be absent for method " + method + ": the startup time is the front's second objective");
+  if (base.constraints.penalty_weight > 0)
+    throw ConfigError("constraints.penalty_weight", format_number(base.constraints.penalty_weight),
+                      "must be 0 for method " + method + ": " + (moead ? "MOEA/D" : "NSGA-II") +
+                          " sees the constraints itself (feasibility rules)");
+  opt::check_two_objective_population(moead ? opt::TwoObjectiveMethod::Moead : opt::TwoObjectiveMethod::Nsga2,
+                                      pareto.population, pareto.max_evaluations, "pareto.population",
+                                      "pareto.max_evaluations");
+  FrontProblem fp;
+  fp.label = label;
+  fp.settings = base;
+  fp.second_objective = "startup_time_s";
+  fp.max_evaluations = pareto.max_evaluations;
+  fp.seeds = 1;
+  fp.seed = options.seed;
+  fp.constraint_tolerance = options.constraint_tolerance;
+  fp.reference = pareto.reference;
+  FrontMethod m;
+  m.kind = moead ? FrontMethod::Kind::Moead : FrontMethod::Kind::Nsga2;
+  m.label = moead ? "MOEA/D" : "NSGA-II";
+  m.options = options;
+  m.options.population = pareto.population;
+  fp.methods.push_back(m);
+  return fp;
 }
 
 FrontProblem read_front_problem(YamlReader& r) {
@@ -184,7 +219,7 @@ opt::OptimizerOptions run_options(const FrontProblem& fp, const FrontMethod& m, 
   return o;
 }
 
-void run_nsga2(const FrontProblem& fp, const FrontMethod& m, const std::vector<double>& x0, int k, int threads,
+void run_pagmo(const FrontProblem& fp, const FrontMethod& m, const std::vector<double>& x0, int k, int threads,
                const std::string& archive_path, FrontRun& run) {
   problems::StartupProfileProblem problem(fp.settings);
   std::unique_ptr<opt::EvaluationArchive> archive;
@@ -195,7 +230,9 @@ void run_nsga2(const FrontProblem& fp, const FrontMethod& m, const std::vector<d
   }
   opt::Problem& target = archived ? static_cast<opt::Problem&>(*archived) : problem;
   const opt::OptimizerOptions o = run_options(fp, m, fp.max_evaluations, k, threads);
-  const opt::TwoObjectiveResult r = opt::minimize_two_objectives(target, fp.second_objective, o, x0);
+  const opt::TwoObjectiveResult r = opt::minimize_two_objectives(
+      target, fp.second_objective, o, x0,
+      m.kind == FrontMethod::Kind::Moead ? opt::TwoObjectiveMethod::Moead : opt::TwoObjectiveMethod::Nsga2);
   run.evaluations = r.run.evaluations;
   run.reason = opt::to_string(r.run.reason);
   for (std::size_t i : r.front) {
@@ -282,7 +319,7 @@ FrontComparison run_front_comparison(
           dir.empty() ? std::string() : (dir / ("run" + std::to_string(k) + "-" + file_safe(m.label) + ".sqlite")).string();
       const auto started = std::chrono::steady_clock::now();
       try {
-        if (m.kind == FrontMethod::Kind::Nsga2) run_nsga2(fp, m, starts[k], k, threads, archive_path, run);
+        if (m.kind != FrontMethod::Kind::EpsilonConstraint) run_pagmo(fp, m, starts[k], k, threads, archive_path, run);
         else run_epsilon_constraint(fp, m, starts[k], k, threads, archive_path, run);
       } catch (const std::exception& e) {  // recorded, never fatal to the other runs
         run.points.clear();

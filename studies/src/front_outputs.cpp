@@ -61,7 +61,7 @@ std::string format_front_table(const FrontComparison& c) {
   std::ostringstream os;
   for (const FrontProblem& fp : c.problems) {
     os << "\nfront " << fp.label << ": objective against " << fp.second_objective << ", " << fp.max_evaluations
-       << " evaluations per run, " << fp.seeds << " runs per method; hypervolume against ("
+       << " evaluations per run, " << fp.seeds << (fp.seeds == 1 ? " run" : " runs") << " per method; hypervolume against ("
        << format_number(fp.reference.first) << ", " << format_number(fp.reference.second) << ")\n";
     os << std::left << std::setw(18) << "method" << std::right << std::setw(6) << "runs" << std::setw(8) << "evals"
        << std::setw(28) << "hv in sample [range]" << std::setw(28) << "hv out of sample [range]" << std::setw(14)
@@ -152,7 +152,7 @@ void write_front_outputs(const FrontComparison& c, const std::string& directory,
     std::ostringstream body;
     body << "set key top left box opaque\nset grid\n"
          << "set title " << plot_style::literal("Fronts on " + fp.label + ": " + std::to_string(fp.seeds) +
-                                                " runs per method, " + std::to_string(fp.max_evaluations) +
+                                                (fp.seeds == 1 ? " run" : " runs") + " per method, " + std::to_string(fp.max_evaluations) +
                                                 " evaluations each")
          << "\nset xlabel "
          << plot_style::literal(fp.second_objective == "startup_time_s" ? "startup time T [s]" : fp.second_objective)

@@ -13,6 +13,7 @@
 #include "abuopt/common/text.hpp"
 #include "abuopt/optimizer/evaluation_archive.hpp"
 #include "abuopt/optimizer/minimize.hpp"
+#include "abuopt/optimizer/multi_objective.hpp"
 #include "abuopt/optimizer/penalty_problem.hpp"
 #include "abuopt/studies/sweep.hpp"
 
@@ -22,10 +23,50 @@ namespace {
 namespace fs = std::filesystem;
 }
 
+std::string to_string(ParetoSettings::Method m) {
+  switch (m) {
+    case ParetoSettings::Method::Nsga2: return "nsga2";
+    case ParetoSettings::Method::Moead: return "moead";
+    default: return "epsilon_constraint";
+  }
+}
+
 ParetoSettings read_pareto_settings(YamlReader section) {
   if (!section.present())
     throw ConfigError("pareto", "(absent)", "a Pareto front needs a `pareto` section (max_startup_time_s: [...])");
   ParetoSettings s;
+  const std::string method = section.get_string_or("method", "epsilon_constraint");
+  if (method == "nsga2") s.method = ParetoSettings::Method::Nsga2;
+  else if (method == "moead") s.method = ParetoSettings::Method::Moead;
+  else if (method != "epsilon_constraint")
+    throw ConfigError(section.key_path("method"), method, "must be epsilon_constraint, nsga2 or moead");
+  if (s.method != ParetoSettings::Method::EpsilonConstraint) {
+    for (const char* key : {"max_startup_time_s", "warm_start"})
+      if (section.has(key))
+        throw ConfigError(section.key_path(key), yaml_value_text(section.node()[key]),
+                          "means nothing for method " + method +
+                              ": its front spans every startup time the design allows (the reference bounds the "
+                              "hypervolume); bounds belong to method epsilon_constraint");
+    s.max_evaluations = section.get_int("max_evaluations", Rule::positive());
+    s.population = section.get_int_or("population", 20, Rule::in_range(1, 100000));
+    opt::check_two_objective_population(
+        s.method == ParetoSettings::Method::Moead ? opt::TwoObjectiveMethod::Moead : opt::TwoObjectiveMethod::Nsga2,
+        s.population, s.max_evaluations, section.key_path("population"), section.key_path("max_evaluations"));
+    YamlReader ref = section.child("reference");
+    if (!ref.present())
+      throw ConfigError(section.key_path("reference"), "<missing>",
+                        "is required for method " + method +
+                            ": {objective: F, second: T_s}, the hypervolume's reference point, beyond the front");
+    s.reference.first = ref.get_double("objective", Rule::positive());
+    s.reference.second = ref.get_double("second", Rule::positive());
+    ref.finish();
+    section.finish();
+    return s;
+  }
+  for (const char* key : {"max_evaluations", "population", "reference"})
+    if (section.has(key))
+      throw ConfigError(section.key_path(key), yaml_value_text(section.node()[key]),
+                        "only for method nsga2 or moead (the series' budget per bound is optimizer.max_evaluations)");
   s.max_startup_time_s = section.get_double_list("max_startup_time_s", Rule::positive());
   if (s.max_startup_time_s.size() < 2)
     throw ConfigError(section.key_path("max_startup_time_s"), std::to_string(s.max_startup_time_s.size()) + " values",
@@ -74,6 +115,10 @@ ParetoResult run_pareto(const problems::StartupProfileSettings& base, const opt:
                         const ParetoSettings& pareto, const std::string& archive_path,
                         const std::string& command_config, const std::string& config_hash,
                         const ParetoProgress& progress, bool validate, const std::vector<double>& x0) {
+  if (pareto.method != ParetoSettings::Method::EpsilonConstraint)
+    throw ConfigError("pareto.method", to_string(pareto.method),
+                      "this runs the epsilon-constraint series only; methods nsga2 and moead run with the command "
+                      "`abuopt pareto` (in C++: pareto_front_problem and run_front_comparison)");
   if (base.constraints.max_startup_time_s)
     throw ConfigError("constraints.max_startup_time_s", format_number(*base.constraints.max_startup_time_s),
                       "must be absent for a Pareto front: pareto.max_startup_time_s sets it for each point");

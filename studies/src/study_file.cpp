@@ -12,6 +12,7 @@
 #include "abuopt/common/config_error.hpp"
 #include "abuopt/common/text.hpp"
 #include "abuopt/core/simulation_config.hpp"
+#include "abuopt/optimizer/multi_objective.hpp"
 #include "abuopt/studies/study.hpp"
 
 namespace abuopt::studies {
@@ -47,7 +48,30 @@ StageSpec read_stage(YamlReader& r) {
     if (name == kind) s.kind = k;
   s.name = r.get_string_or("name", kind);
   const bool optimiser = s.kind == StageKind::Global || s.kind == StageKind::Local || s.kind == StageKind::Pareto;
-  if (s.kind == StageKind::Pareto) {
+  if (s.kind == StageKind::Pareto)
+    s.pareto_method = r.get_choice_or("method", "epsilon_constraint", {"epsilon_constraint", "nsga2", "moead"});
+  const bool population_front = s.kind == StageKind::Pareto && s.pareto_method != "epsilon_constraint";
+  if (s.kind != StageKind::Pareto || !population_front)
+    for (const char* k : {"population", "points"})
+      if (r.has(k))
+        throw ConfigError(r.key_path(k), yaml_value_text(r.node()[k]),
+                          "is only used by a pareto stage with method nsga2 or moead");
+  if (population_front) {
+    r.get_choice_or("over", "startup_time", {"startup_time"});
+    if (r.has("bounds"))
+      throw ConfigError(r.key_path("bounds"), yaml_value_text(r.node()["bounds"]),
+                        "means nothing for method " + s.pareto_method +
+                            ": its front spans every startup time the family allows (bounds belong to "
+                            "method epsilon_constraint)");
+    if (r.has("optimizer") && r.child("optimizer").has("algorithm"))
+      throw ConfigError(r.key_path("optimizer") + ".algorithm",
+                        yaml_value_text(r.node()["optimizer"]["algorithm"]),
+                        "must be absent with method " + s.pareto_method +
+                            " (the method is the stage's method; optimizer gives max_evaluations, the front's "
+                            "budget per choice, and seed)");
+    s.pareto_population = r.get_int_or("population", 20, Rule::in_range(1, 100000));
+    s.pareto_points = static_cast<std::size_t>(r.get_int_or("points", 12, Rule::in_range(2, 1000)));
+  } else if (s.kind == StageKind::Pareto) {
     r.get_choice_or("over", "startup_time", {"startup_time"});
     if (!r.has("bounds"))
       throw ConfigError(r.key_path("bounds"), "<missing>",
@@ -66,6 +90,11 @@ StageSpec read_stage(YamlReader& r) {
     YamlReader o = r.child("optimizer");
     s.optimizer = opt::read_optimizer_options(o);
     s.optimizer.validate();
+    if (population_front)
+      opt::check_two_objective_population(
+          s.pareto_method == "moead" ? opt::TwoObjectiveMethod::Moead : opt::TwoObjectiveMethod::Nsga2,
+          s.pareto_population, s.optimizer.max_evaluations, r.key_path("population"),
+          r.key_path("optimizer") + ".max_evaluations");
     s.penalty_weight = r.get_double_or("penalty_weight", s.penalty_weight, Rule::positive());
     if (s.kind == StageKind::Pareto) {  // optional: the front's points on fresh samples
       if (r.has("seeds")) s.seeds = read_seeds(r, "seeds");

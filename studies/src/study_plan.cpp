@@ -61,8 +61,9 @@ StudyPlan plan_of(const StudyFile& f) {
   for (const StageSpec& s : f.stages)
     if (s.kind == StageKind::Global || s.kind == StageKind::Local)
       optimiser += s.optimizer.max_evaluations * choices;
-    else if (s.kind == StageKind::Pareto)
-      optimiser += s.optimizer.max_evaluations * choices * static_cast<long long>(s.pareto_bounds.size());
+    else if (s.kind == StageKind::Pareto)  // a run per bound and choice, or one run per choice (nsga2, moead)
+      optimiser += s.optimizer.max_evaluations * choices *
+                   (s.pareto_method == "epsilon_constraint" ? static_cast<long long>(s.pareto_bounds.size()) : 1LL);
   p.optimiser_evaluations = std::min<long long>(optimiser, f.max_evaluations);
   p.other_evaluations = 1;  // the baseline
   long long fresh = 0;      // simulations on fresh samples
@@ -72,7 +73,9 @@ StudyPlan plan_of(const StudyFile& f) {
     const long long seeds = static_cast<long long>(s.seeds.size());
     long long n = 0;  // Monte Carlos of stage_runs
     if (s.kind == StageKind::Pareto) {  // each front point and the baseline on every fresh sample
-      n = seeds * (choices * static_cast<long long>(s.pareto_bounds.size()) + 1);
+      n = seeds * (choices * static_cast<long long>(s.pareto_method == "epsilon_constraint" ? s.pareto_bounds.size()
+                                                                                           : s.pareto_points) +
+                   1);
     } else if (s.kind == StageKind::Replicate) {
       n = seeds * (choices + 1);
     } else if (s.kind == StageKind::Validate) {
@@ -155,7 +158,14 @@ std::string plan_text(const StudyFile& f) {
   os << "stages:\n";
   for (const StageSpec& s : f.stages) {
     os << "  " << s.name << " (" << to_string(s.kind) << "): ";
-    if (s.kind == StageKind::Pareto) {
+    if (s.kind == StageKind::Pareto && s.pareto_method != "epsilon_constraint") {
+      os << "the front of the objective against T by " << (s.pareto_method == "moead" ? "MOEA/D" : "NSGA-II")
+         << " (population " << s.pareto_population << "), " << s.optimizer.max_evaluations
+         << " evaluations per choice, from the best so far; at most " << s.pareto_points << " front points kept";
+      if (!s.seeds.empty())
+        os << "; each point on " << s.seeds.size() << " fresh samples of " << (s.runs ? s.runs : f.base.runs) << " runs";
+      os << "\n";
+    } else if (s.kind == StageKind::Pareto) {
       os << "the front of the objective against T <=";
       for (std::size_t i = 0; i < s.pareto_bounds.size(); ++i) os << (i ? ", " : " ") << format_number(s.pareto_bounds[i]);
       os << " s; " << s.optimizer.algorithm << ", at most " << s.optimizer.max_evaluations

@@ -277,8 +277,12 @@ std::string markdown(const StudyFile& f, const StudyResult& r) {
   if (!r.front.points.empty()) {
     const ParetoFront& fr = r.front;
     const bool oos = !fr.seeds.empty();
-    md << "\n## Pareto front (stage " << fr.stage << ")\n\nThe least objective at each bound on the startup time T "
-       << "(epsilon-constraint), mean |I_r| in 1e-7 kg m; "
+    md << "\n## Pareto front (stage " << fr.stage << ")\n\n"
+       << (fr.method == "epsilon_constraint"
+               ? std::string("The least objective at each bound on the startup time T (epsilon-constraint)")
+               : std::string("The front of one ") + (fr.method == "moead" ? "MOEA/D" : "NSGA-II") +
+                     " run on the objective and T at once (the bound column is each point's own T)")
+       << ", mean |I_r| in 1e-7 kg m; "
        << (oos ? "in sample and on " + std::to_string(fr.seeds.size()) + " fresh samples of " + std::to_string(fr.runs) +
                      " runs (mean and 95 % interval).\n\n"
                : "in sample only (biased low: the optimiser chose on that sample).\n\n")
@@ -389,7 +393,7 @@ nlohmann::json summary(const StudyFile& f, const StudyResult& r) {
       }
       pts.push_back(jp);
     }
-    j["pareto"] = {{"stage", fr.stage}, {"points", pts}};
+    j["pareto"] = {{"stage", fr.stage}, {"method", fr.method}, {"points", pts}};
     if (!fr.seeds.empty()) {
       j["pareto"]["seeds"] = fr.seeds;
       j["pareto"]["runs"] = fr.runs;

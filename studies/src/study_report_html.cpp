@@ -122,8 +122,13 @@ std::string pareto_html(const StudyFile& f, const StudyResult& r) {
   h << "<h2>Pareto front: mean |I<sub>r</sub>| against startup time</h2>\n<figure>"
     << svg_line_chart("Least mean |I_r| at each bound on the startup time", "startup time T [s]",
                       "mean |I_r| [1e-7 kg m]", series, 900, 420)
-    << "<figcaption>Stage " << esc(fr.stage) << ": for each bound on T, the study's objective minimised with T &le; the "
-       "bound and the study's other constraints (epsilon-constraint; each bound starts from the previous bound's best). "
+    << "<figcaption>Stage " << esc(fr.stage) << ": "
+    << (fr.method == "epsilon_constraint"
+            ? std::string("for each bound on T, the study's objective minimised with T &le; the bound and the study's "
+                          "other constraints (epsilon-constraint; each bound starts from the previous bound's best). ")
+            : std::string("one ") + (fr.method == "moead" ? "MOEA/D" : "NSGA-II") +
+                  " run on the study's objective and T at once under the study's other constraints; its non-dominated "
+                  "feasible designs (the bound column is each point's own T). ")
     << (oos ? "Filled dots: in sample (the sample the optimiser chose on, biased low); hollow dots: the same designs and "
               "the baseline on fresh samples."
             : "In sample only (the sample the optimiser chose on, biased low): give the stage seeds to check the front "

@@ -357,8 +357,67 @@ def mode_pareto():
                 fail(f"bad pareto stage ({new}): {p.stderr}")
         print(f"ok: pareto stage: {len(front['points'])} bounds, {len(feasible)} feasible, in and out of sample, "
               "rerun from the archive")
+        mode_pareto_nsga2(tmp)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+
+
+def mode_pareto_nsga2(tmp):
+    """The tiny study with `method: nsga2` in its pareto stage: one NSGA-II run of 16 evaluations on
+    mean |I_r| and T at once, at most 4 front points kept and checked on 2 fresh samples."""
+    text = open(tiny_study(tmp)).read()
+    stage = ("  - {kind: pareto, method: nsga2, population: 8, points: 4, optimizer: {max_evaluations: 16, seed: 5}, "
+             "seeds: [101, 102], runs: 4}\n")
+    text = text.replace("  - kind: validate", stage + "  - kind: validate")
+    text = text.replace("amplitude_vs_baseline: 1.0", "amplitude_vs_baseline: 3.0")
+    study = os.path.join(tmp, "nsga2.yaml")
+    open(study, "w").write(text)
+    plan = run(["study", study, "--check"]).stdout
+    if "by NSGA-II (population 8), 16 evaluations per choice" not in plan:
+        fail(f"--check does not show the NSGA-II stage:\n{plan}")
+    out = os.path.join(tmp, "n")
+    run(["study", study, "--out", out, "--threads", "1"])
+    s = json.load(open(os.path.join(out, "summary.json")))
+    front = s.get("pareto")
+    if not front or front.get("method") != "nsga2" or not 1 <= len(front["points"]) <= 4:
+        fail(f"summary.json pareto (nsga2): {front}")
+    ts = [p["startup_time_s"] for p in front["points"]]
+    if ts != sorted(ts):
+        fail(f"front points not by T: {ts}")
+    for p in front["points"]:
+        if abs(p["bound_s"] - p["startup_time_s"]) > 1e-9 * p["startup_time_s"]:
+            fail(f"bound_s {p['bound_s']} is not the point's own T {p['startup_time_s']}")
+        if not p["label"].startswith("pareto_T") or not os.path.exists(os.path.join(out, p["file"])):
+            fail(f"front point {p['label']}: {p['file']}")
+        if not p["feasible"] or p["dominated"]:
+            fail(f"an NSGA-II front point infeasible or dominated in sample: {p}")
+        if p["evaluations"] != 16:
+            fail(f"NSGA-II spent {p['evaluations']} of its 16 evaluations")
+        if p["out_of_sample_mean_abs_ir"]["samples"] != 2:
+            fail(f"out of sample: {p['out_of_sample_mean_abs_ir']}")
+    md = open(os.path.join(out, "report.md")).read()
+    if "NSGA-II run on the objective and T at once" not in md:
+        fail("report.md does not say how the front was made")
+    run(["study", study, "--out", out, "--threads", "1"])
+    s2 = json.load(open(os.path.join(out, "summary.json")))
+    if s2["archive_hits"] != s2["evaluations"] or comparable(s2) != comparable(s):
+        fail("a rerun of the NSGA-II front from the archive changed it or computed again")
+    for old, new, want in [
+            ("method: nsga2,", "method: nsga2, bounds: [8, 12],", "stages[3].bounds = [8, 12]: means nothing for method nsga2"),
+            ("population: 8,", "population: 10,", "stages[3].population = 10: NSGA-II needs a multiple of 4"),
+            ("population: 8,", "population: 20,",
+             "stages[3].optimizer.max_evaluations = 16: NSGA-II needs at least one population (20 evaluations)"),
+            ("optimizer: {max_evaluations: 16,", "optimizer: {algorithm: cobyla, max_evaluations: 16,",
+             "stages[3].optimizer.algorithm = cobyla: must be absent with method nsga2"),
+            ("method: nsga2, population: 8, points: 4,", "population: 8, bounds: [8, 12],",
+             "stages[3].population = 8: is only used by a pareto stage with method nsga2 or moead")]:
+        bad = os.path.join(tmp, "bad_nsga2.yaml")
+        open(bad, "w").write(text.replace(old, new))
+        p = run(["study", bad, "--check"], expect=2)
+        if want not in p.stderr:
+            fail(f"bad nsga2 pareto stage ({new}): {p.stderr}")
+    print(f"ok: pareto stage by NSGA-II: {len(front['points'])} points (T {ts[0]:.2f} - {ts[-1]:.2f} s), "
+          "feasible and non-dominated, on fresh samples, rerun from the archive")
 
 
 def yaml_balls(path):

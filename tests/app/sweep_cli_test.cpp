@@ -12,9 +12,11 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -288,6 +290,115 @@ TEST(SweepCli, ParetoSeriesWritesTheFrontAndValidatesItOutOfSample) {
   const Result b = run("pareto " + bad + " --out " + fresh_dir("pareto-bad").string());
   EXPECT_EQ(b.status, 2) << b.output;
   EXPECT_NE(b.output.find("constraints.max_startup_time_s = 20: must be absent"), std::string::npos) << b.output;
+}
+
+// pareto.method nsga2 / moead: the shipped configs/sweep/pareto_time_nsga2.yaml at a reduced size
+// (8 runs per evaluation, 40 evaluations, 32 validation runs): the budget spent exactly, the front's
+// files as compare writes them (hypervolume.csv equal to summary.json), a rerun answered from the
+// archive bit for bit; MOEA/D likewise; bad keys are status 2 naming the key.
+std::string reduced_nsga2_config(const std::vector<std::pair<std::string, std::string>>& edits = {}) {
+  std::ifstream in(std::string(ABUOPT_SOURCE_DIR) + "/configs/sweep/pareto_time_nsga2.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto replace = [&](const std::string& from, const std::string& to) {
+    const auto at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+  };
+  replace("  runs: 128\n", "  runs: 8\n");
+  replace("  runs: 1024\n", "  runs: 32\n");
+  replace("  max_evaluations: 440", "  max_evaluations: 40");
+  for (const auto& [from, to] : edits) replace(from, to);
+  return text;
+}
+
+TEST(SweepCli, ParetoByNsga2AndMoeadWritesTheValidatedFrontAndResumes) {
+  const std::string cfg = write_config("pareto_time_nsga2.yaml", reduced_nsga2_config());
+  const fs::path out = fresh_dir("pareto-nsga2");
+  const Result r = run("pareto " + cfg + " --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("NSGA-II (population 20, seed 304)"), std::string::npos) << r.output;
+  const Csv hv = read_csv(out / "hypervolume.csv");
+  ASSERT_EQ(hv.rows.size(), 1u);
+  EXPECT_EQ(hv.at(0, "method"), "NSGA-II");
+  EXPECT_EQ(hv.at(0, "evaluations"), "40");  // NSGA-II spends the budget
+  EXPECT_EQ(hv.at(0, "validated"), "1");
+  EXPECT_GT(parse(hv.at(0, "hv_in")), 0.0);
+  const Csv fronts = read_csv(out / "fronts.csv");
+  ASSERT_GE(fronts.rows.size(), 1u);
+  for (std::size_t i = 0; i < fronts.rows.size(); ++i) {
+    // T = dt1 + dt2 + dt3 of the design box: 2.3 s to 25 s
+    EXPECT_GE(parse(fronts.at(i, "second")), 2.3 - 1e-9);
+    EXPECT_LE(parse(fronts.at(i, "second")), 25 + 1e-9);
+    EXPECT_FALSE(fronts.at(i, "validated_objective").empty()) << i;  // every point out of sample
+  }
+  const nlohmann::json s = read_json(out / "summary.json");
+  expect_provenance(s, cfg);
+  EXPECT_EQ(s["method"], "nsga2");
+  EXPECT_EQ(s["algorithm"], "pagmo_nsga2");
+  EXPECT_EQ(s["evaluations"], 40);
+  EXPECT_EQ(s["points"].size(), fronts.rows.size());
+  EXPECT_NEAR(s["hypervolume"]["in_sample"].get<double>(), parse(hv.at(0, "hv_in")), 1e-9);
+  EXPECT_NEAR(s["hypervolume"]["out_of_sample"].get<double>(), parse(hv.at(0, "hv_out")), 1e-9);
+  EXPECT_TRUE(fs::exists(out / "archive" / "pareto_time_nsga2" / "run0-NSGA-II.sqlite"));
+
+  // A rerun: every evaluation from the archive, the same front to the bit.
+  const Result again = run("pareto " + cfg + " --out " + out.string());
+  ASSERT_EQ(again.status, 0) << again.output;
+  const nlohmann::json s2 = read_json(out / "summary.json");
+  EXPECT_EQ(bits(s2["hypervolume"]["in_sample"].get<double>()), bits(s["hypervolume"]["in_sample"].get<double>()));
+  EXPECT_EQ(bits(s2["hypervolume"]["out_of_sample"].get<double>()),
+            bits(s["hypervolume"]["out_of_sample"].get<double>()));
+  EXPECT_EQ(s2["points"], s["points"]);
+
+  const std::string moead =
+      write_config("pareto_time_moead.yaml", reduced_nsga2_config({{"method: nsga2", "method: moead"}, {"population: 20", "population: 10"}}));
+  const fs::path mout = fresh_dir("pareto-moead");
+  const Result m = run("pareto " + moead + " --out " + mout.string());
+  ASSERT_EQ(m.status, 0) << m.output;
+  const nlohmann::json ms = read_json(mout / "summary.json");
+  EXPECT_EQ(ms["algorithm"], "pagmo_moead");
+  EXPECT_EQ(ms["population"], 10);
+  EXPECT_EQ(ms["evaluations"], 40);
+  EXPECT_GT(ms["hypervolume"]["in_sample"].get<double>(), 0.0);
+  EXPECT_TRUE(fs::exists(mout / "archive" / "pareto_time_moead" / "run0-MOEA_D.sqlite"));
+
+  // Bad input: status 2 naming the key, the value and the rule.
+  using Edits = std::vector<std::pair<std::string, std::string>>;
+  const std::pair<Edits, std::string> bad[] = {
+      {{{"method: nsga2", "method: nsga2\n  max_startup_time_s: [10, 20]"}},
+       "pareto.max_startup_time_s = [10, 20]: means nothing for method nsga2"},
+      {{{"population: 20", "population: 10"}}, "pareto.population = 10: NSGA-II needs a multiple of 4, at least 8"},
+      {{{"method: nsga2", "method: moead"}, {"population: 20", "population: 3"}},
+       "pareto.population = 3: MOEA/D needs at least 4"},
+      {{{"population: 20", "population: 480"}},
+       "pareto.max_evaluations = 40: NSGA-II needs at least one population (480 evaluations)"},
+      {{{"method: nsga2", "method: nsga3"}}, "pareto.method = nsga3: must be epsilon_constraint, nsga2 or moead"},
+  };
+  int k = 0;
+  for (const auto& [edits, message] : bad) {
+    const std::string c = write_config("pareto-bad-" + std::to_string(k) + ".yaml", reduced_nsga2_config(edits));
+    const Result b = run("pareto " + c + " --out " + fresh_dir("pareto-bad-" + std::to_string(k++)).string());
+    EXPECT_EQ(b.status, 2) << b.output;
+    EXPECT_NE(b.output.find(message), std::string::npos) << b.output;
+  }
+  const std::string no_ref = write_config("pareto-noref.yaml", std::string(kBase) +
+                                                                   "pareto: {method: moead, max_evaluations: 20}\n");
+  const Result nr = run("pareto " + no_ref + " --out " + fresh_dir("pareto-noref").string());
+  EXPECT_EQ(nr.status, 2) << nr.output;
+  EXPECT_NE(nr.output.find("pareto.reference = <missing>: is required for method moead"), std::string::npos) << nr.output;
+  const std::string algo = write_config("pareto-algo.yaml", std::string(kBase) +
+                                                                "optimizer: {algorithm: cobyla}\n"
+                                                                "pareto: {method: nsga2, max_evaluations: 40, "
+                                                                "reference: {objective: 25, second: 23}}\n");
+  const Result al = run("pareto " + algo + " --out " + fresh_dir("pareto-algo").string());
+  EXPECT_EQ(al.status, 2) << al.output;
+  EXPECT_NE(al.output.find("optimizer.algorithm = cobyla: must be absent with pareto.method nsga2"), std::string::npos)
+      << al.output;
+  const std::string eps = write_config("pareto-eps-pop.yaml", std::string(kBase) +
+                                                                  "pareto: {max_startup_time_s: [12, 18], population: 20}\n");
+  const Result ep = run("pareto " + eps + " --out " + fresh_dir("pareto-eps-pop").string());
+  EXPECT_EQ(ep.status, 2) << ep.output;
+  EXPECT_NE(ep.output.find("pareto.population = 20: only for method nsga2 or moead"), std::string::npos) << ep.output;
 }
 
 TEST(SweepCli, BadSweepInputIsStatus2WithTheKey) {

@@ -211,7 +211,9 @@ TEST(TwoObjectives, Nsga2ApproachesTheZdt1Front) {
     EXPECT_GE(hv, 0.97 * exact) << constrained;
     for (std::size_t i : r.front) {
       EXPECT_TRUE(r.run.history[i].feasible);
-      if (constrained) EXPECT_GE(r.run.history[i].x[0], 0.2 - 1e-6);
+      if (constrained) {
+        EXPECT_GE(r.run.history[i].x[0], 0.2 - 1e-6);
+      }
     }
   }
   opt::FunctionProblem p = zdt1(false);
@@ -221,5 +223,41 @@ TEST(TwoObjectives, Nsga2ApproachesTheZdt1Front) {
   o.population = 0;
   EXPECT_THROW((void)opt::minimize_two_objectives(p, "", o), ConfigError);
 }
+
+TEST(TwoObjectives, MoeadApproachesTheZdt1Front) {
+  // Same problems, budget and tolerance as NSGA-II above, from two seeds each; the constraint is
+  // folded into both fitness values (no point below x0 = 0.2 may enter the front).
+  for (const bool constrained : {false, true})
+    for (const unsigned long seed : {5ul, 6ul}) {
+      opt::FunctionProblem p = zdt1(constrained);
+      opt::OptimizerOptions o = options("cobyla", 800, seed);
+      o.population = 20;
+      const opt::TwoObjectiveResult r =
+          opt::minimize_two_objectives(p, "f2", o, {}, opt::TwoObjectiveMethod::Moead);
+      EXPECT_EQ(r.run.evaluations, 800);
+      EXPECT_EQ(r.run.algorithm, "PAGMO_MOEAD");
+      ASSERT_GE(r.front.size(), 10u) << constrained << " " << seed;
+      const double exact = constrained ? 2.0 / 3.0 * (1 - std::pow(0.2, 1.5)) : 2.0 / 3.0;
+      const double hv = opt::hypervolume_2d(r.front_objectives(), {1, 1});
+      EXPECT_LE(hv, exact + 1e-12) << constrained << " " << seed;
+      EXPECT_GE(hv, 0.97 * exact) << constrained << " " << seed;
+      for (std::size_t i : r.front) {
+        EXPECT_TRUE(r.run.history[i].feasible);
+        if (constrained) {
+          EXPECT_GE(r.run.history[i].x[0], 0.2 - 1e-6);
+        }
+      }
+    }
+  opt::FunctionProblem p = zdt1(false);
+  opt::OptimizerOptions o = options("cobyla", 100);
+  o.population = 10;  // MOEA/D takes any population of 4 or more
+  EXPECT_EQ(opt::minimize_two_objectives(p, "f2", o, {}, opt::TwoObjectiveMethod::Moead).run.evaluations, 100);
+  o.population = 3;
+  EXPECT_THROW((void)opt::minimize_two_objectives(p, "f2", o, {}, opt::TwoObjectiveMethod::Moead), ConfigError);
+  EXPECT_EQ(opt::two_objective_method_from_string("moead", "k"), opt::TwoObjectiveMethod::Moead);
+  EXPECT_EQ(opt::two_objective_method_from_string("pagmo_nsga2", "k"), opt::TwoObjectiveMethod::Nsga2);
+  EXPECT_THROW((void)opt::two_objective_method_from_string("spea2", "k"), ConfigError);
+}
+
 
 }  // namespace

@@ -1,6 +1,7 @@
 // Two-objective problems of `abuopt compare` (studies/front_comparison.hpp): a bad `fronts:` entry
 // is one ConfigError naming its key; the budget split of the epsilon-constraint series; on a small
-// front problem (8 Monte Carlo runs per evaluation, 48 evaluations, 2 seeds): the equal-evaluations
+// front problem (8 Monte Carlo runs per evaluation, 48 evaluations, 2 seeds; NSGA-II, MOEA/D and the
+// epsilon-constraint series): the equal-evaluations
 // rule, hypervolume.csv equal to opt::hypervolume_2d of the points written to fronts.csv (1e-12),
 // and a rerun on the same archive answering every run bit for bit. A few seconds.
 #include <gtest/gtest.h>
@@ -54,6 +55,7 @@ std::string front_yaml(const std::string& methods, const std::string& extra = ""
 
 const std::string kMethods =
     "  - {label: NSGA-II, algorithm: pagmo_nsga2, population: 8}\n"
+    "  - {label: MOEA/D, algorithm: pagmo_moead, population: 8}\n"
     "  - {label: eps, algorithm: epsilon_constraint, bounds_s: [10, 16, 23], warm_start: false,\n"
     "     inner: {algorithm: cobyla, options: {initial_step: 0.1}}}\n";
 
@@ -74,7 +76,9 @@ std::string rejected_key(const std::string& text) {
 }
 
 TEST(FrontComparison, BadEntriesAreRejectedNamingTheKey) {
-  EXPECT_EQ(rejected_key(front_yaml("  - {algorithm: pagmo_moead}\n")), "methods[0].algorithm");
+  EXPECT_EQ(rejected_key(front_yaml("  - {algorithm: pagmo_spea2}\n")), "methods[0].algorithm");
+  EXPECT_EQ(rejected_key(front_yaml("  - {algorithm: pagmo_moead, population: 3}\n")), "methods[0].population");
+  EXPECT_EQ(rejected_key(front_yaml("  - {algorithm: pagmo_moead, population: 50}\n")), "methods[0].population");
   EXPECT_EQ(rejected_key(front_yaml("  - {algorithm: epsilon_constraint, bounds_s: []}\n")), "methods[0].bounds_s");
   EXPECT_EQ(rejected_key(front_yaml("  - {algorithm: epsilon_constraint, bounds_s: [10, 10, 20]}\n")),
             "methods[0].bounds_s");
@@ -134,12 +138,12 @@ TEST(FrontComparison, HypervolumeOfTheWrittenFrontsAtEqualEvaluations) {
   const fs::path dir = fs::temp_directory_path() / ("abuopt_front_test_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   const FrontComparison c = run_front_comparison({fp}, (dir / "archive").string(), 2);
-  ASSERT_EQ(c.runs.size(), 4u);  // 2 seeds x 2 methods
+  ASSERT_EQ(c.runs.size(), 6u);  // 2 seeds x 3 methods
   for (const FrontRun& r : c.runs) {
     SCOPED_TRACE(r.method + " run " + std::to_string(r.run) + ": " + r.reason);
     EXPECT_LE(r.evaluations, fp.max_evaluations);
-    if (r.method == "NSGA-II") {
-      EXPECT_EQ(r.evaluations, fp.max_evaluations);  // NSGA-II spends the budget
+    if (r.method != "eps") {
+      EXPECT_EQ(r.evaluations, fp.max_evaluations);  // NSGA-II and MOEA/D spend the budget
       EXPECT_EQ(r.inner_budget, 0);
     } else {
       EXPECT_EQ(r.inner_budget, 16);  // 48 / 3 bounds without warm starts
@@ -149,7 +153,7 @@ TEST(FrontComparison, HypervolumeOfTheWrittenFrontsAtEqualEvaluations) {
     EXPECT_GE(r.hv_in, 0.0);
   }
   // at least one front from each method, with a positive hypervolume in and out of sample
-  for (const char* m : {"NSGA-II", "eps"}) {
+  for (const char* m : {"NSGA-II", "MOEA/D", "eps"}) {
     double best_in = 0, best_out = 0;
     for (const FrontRun& r : c.runs)
       if (r.method == m) best_in = std::max(best_in, r.hv_in), best_out = std::max(best_out, r.hv_out);
@@ -168,7 +172,7 @@ TEST(FrontComparison, HypervolumeOfTheWrittenFrontsAtEqualEvaluations) {
     if (f[9] == "1") out[key].emplace_back(std::stod(f[7]), std::stod(f[8]));
   }
   const auto hv = csv_rows(dir / "hypervolume.csv");
-  ASSERT_EQ(hv.size(), 4u);
+  ASSERT_EQ(hv.size(), 6u);
   for (const auto& h : hv) {
     const std::string key = h[1] + "/" + h[2];
     EXPECT_NEAR(std::stod(h[6]), opt::hypervolume_2d(in[key], fp.reference), 1e-12) << key;

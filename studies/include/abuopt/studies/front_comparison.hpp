@@ -1,7 +1,7 @@
 #pragma once
 // Two-objective problems of `abuopt compare` (the `fronts:` section; issue 33 item 4): the
 // startup-profile problem with its objective (mean |I_r|) and a metric (startup time T) both
-// minimised, solved by pagmo's NSGA-II (opt::minimize_two_objectives) and by `abuopt pareto`'s
+// minimised, solved by pagmo's NSGA-II or MOEA/D (opt::minimize_two_objectives) and by `abuopt pareto`'s
 // epsilon-constraint series (run_pareto) at equal evaluations, every front point validated out of
 // sample, compared by hypervolume against one reference point per problem.
 //
@@ -15,14 +15,15 @@
 //       startup_profile: {...}               # an `abuopt optimize` config's sections; no bound on T
 //       methods:
 //         - {label: NSGA-II, algorithm: pagmo_nsga2, population: 20}
+//         - {label: MOEA/D, algorithm: pagmo_moead, population: 20}   # any population >= 4
 //         - {label: eps-constraint, algorithm: epsilon_constraint, bounds_s: [8, 11, 14, 17, 19, 23],
 //            warm_start: true, inner: {algorithm: cobyla, options: {initial_step: 0.1}}}
 //
-// Equal evaluations: NSGA-II gets max_evaluations; the epsilon-constraint series makes one run per
+// Equal evaluations: NSGA-II and MOEA/D get max_evaluations; the epsilon-constraint series makes one run per
 // bound plus (warm_start) one more per bound after the first, each with
 // epsilon_constraint_inner_budget() = floor(max_evaluations / runs), so its total never exceeds
 // the budget and falls short of it by less than one inner run when every run uses its budget.
-// A front point is a feasible in-sample point (NSGA-II: the non-dominated feasible evaluations of
+// A front point is a feasible in-sample point (NSGA-II, MOEA/D: the non-dominated feasible evaluations of
 // the run; epsilon-constraint: each bound's kept best point). Out of sample: the problem's
 // validation section at the point's x; a point infeasible there drops out of the out-of-sample
 // front. hv_in / hv_out = opt::hypervolume_2d of the in-sample / validated points against the
@@ -40,14 +41,15 @@
 #include "abuopt/optimizer/benchmarking.hpp"
 #include "abuopt/optimizer/optimizer_options.hpp"
 #include "abuopt/problems/startup_profile_problem.hpp"
+#include "abuopt/studies/pareto.hpp"
 
 namespace abuopt {
 
 struct FrontMethod {
-  enum class Kind { Nsga2, EpsilonConstraint };
+  enum class Kind { Nsga2, EpsilonConstraint, Moead };
   std::string label;
   Kind kind = Kind::Nsga2;
-  opt::OptimizerOptions options;  // NSGA-II's (population), or the epsilon-constraint's inner optimiser
+  opt::OptimizerOptions options;  // NSGA-II's / MOEA/D's (population), or the epsilon-constraint's inner optimiser
   std::vector<double> bounds_s;   // epsilon-constraint: the bounds on the second objective, ascending
   bool warm_start = true;         // epsilon-constraint: each bound also from the previous bound's best
 };
@@ -71,6 +73,15 @@ struct FrontProblem {
 // that leaves an inner run fewer than dimension + 2 evaluations, duplicate method labels.
 FrontProblem read_front_problem(YamlReader& entry);
 
+// `abuopt pareto` with pareto.method nsga2 or moead: the front as a FrontProblem of one run
+// (label `label`, method "NSGA-II" or "MOEA/D" with pareto.population, budget pareto.max_evaluations,
+// reference pareto.reference, seed and constraint_tolerance from `options`, the run from the
+// design's x0) for run_front_comparison, so its outputs are compare's (fronts.csv, hypervolume.csv,
+// front_<label>.png, every point validated out of sample, archived and resumable). ConfigError: a
+// bound on the startup time or a penalty_weight in `base` (both objectives are the method's own).
+FrontProblem pareto_front_problem(const problems::StartupProfileSettings& base, const opt::OptimizerOptions& options,
+                                  const ParetoSettings& pareto, const std::string& label);
+
 // Runs of the epsilon-constraint series and the budget of each: floor(budget / runs).
 std::size_t epsilon_constraint_runs(std::size_t bounds, bool warm_start);
 long epsilon_constraint_inner_budget(long budget, std::size_t bounds, bool warm_start);
@@ -89,12 +100,12 @@ struct FrontRun {
   int run = 0;
   long evaluations = 0;               // every evaluation of the run (all bounds for the series)
   long budget = 0;                    // the problem's max_evaluations
-  long inner_budget = 0;              // epsilon-constraint: per inner run (0 for NSGA-II)
+  long inner_budget = 0;              // epsilon-constraint: per inner run (0 for pagmo's)
   std::vector<FrontPoint> points;     // the in-sample front points, by objective
   double hv_in = 0, hv_out = 0;
   std::size_t points_out = 0;         // points feasible out of sample
   bool validated = false;
-  std::string reason;                 // NSGA-II's termination, or the series' last bound's
+  std::string reason;                 // pagmo's termination, or the series' last bound's
   double wall_time_s = 0;
 };
 

@@ -17,10 +17,20 @@
 //   pareto:
 //     max_startup_time_s: [10, 12, 14, 16, 18, 20, 22]   # the eps_k, > 0, sorted here
 //     warm_start: true                                   # false: only the run from x0
+//
+// pareto.method nsga2 or moead instead: one run of pagmo's NSGA-II or MOEA/D on both objectives at
+// once (compare's fronts machinery, front_comparison.hpp: pareto_front_problem), no bounds:
+//
+//   pareto:
+//     method: nsga2                     # epsilon_constraint (default) | nsga2 | moead
+//     max_evaluations: 600              # the whole front's budget (required)
+//     population: 20                    # NSGA-II: a multiple of 4, >= 8; MOEA/D: >= 4
+//     reference: {objective: 18, second: 23}   # hypervolume reference point (required)
 #include <cstddef>
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "abuopt/common/yaml_reader.hpp"
@@ -32,11 +42,23 @@
 namespace abuopt {
 
 struct ParetoSettings {
+  enum class Method { EpsilonConstraint, Nsga2, Moead };
+  Method method = Method::EpsilonConstraint;
+  // epsilon_constraint
   std::vector<double> max_startup_time_s;  // sorted ascending, distinct
   bool warm_start = true;
+  // nsga2, moead
+  long max_evaluations = 0;                // the front's budget
+  long population = 20;
+  std::pair<double, double> reference{0, 0};  // (objective, startup time)
 };
+std::string to_string(ParetoSettings::Method m);  // "epsilon_constraint", "nsga2", "moead"
 
-// Reads the `pareto` section (strict; finish() is called). ConfigError naming key, value and rule.
+// Reads the `pareto` section (strict; finish() is called). ConfigError naming key, value and rule:
+// an unknown method; for epsilon_constraint, fewer than 2 bounds, a repeated one, or a key of the
+// population methods; for nsga2/moead, bounds or warm_start given (they mean nothing without a
+// series), max_evaluations or reference missing, a population that does not suit the method or
+// exceeds the budget.
 ParetoSettings read_pareto_settings(YamlReader section);
 
 struct ParetoPoint {
@@ -68,6 +90,7 @@ struct ParetoResult {
 // bound is solved, no validation, `interrupted` is set).
 using ParetoProgress = std::function<bool(std::size_t, std::size_t, const opt::Progress&)>;
 
+// The epsilon-constraint series (pareto.method must be epsilon_constraint, else ConfigError).
 // Solves every bound (archive at archive_path, shared by all of them; problem ids differ), then,
 // unless interrupted or `validate` is false, the out-of-sample evaluations. `base` must not bound
 // the startup time itself (ConfigError: constraints.max_startup_time_s is set by the series).

@@ -59,6 +59,12 @@ struct StageSpec {
   std::size_t map_runs = 0;         // runs per map point (0: the stage's runs)
   // pareto: the bounds on the startup time T [s], ascending (key `bounds`; `over: startup_time`)
   std::vector<double> pareto_bounds;
+  // pareto `method`: "epsilon_constraint" (the bounds), "nsga2" or "moead" (one pagmo run per
+  // choice on the objective and T at once, budget optimizer.max_evaluations, no bounds), with the
+  // population and the most front points kept (spread over T; each a design, checked on the seeds)
+  std::string pareto_method = "epsilon_constraint";
+  long pareto_population = 20;
+  std::size_t pareto_points = 12;
 };
 
 struct RelativeConstraints {
@@ -171,6 +177,7 @@ struct FrontPoint {
 };
 struct ParetoFront {
   std::string stage;             // the stage's name (empty: no pareto stage ran)
+  std::string method = "epsilon_constraint";  // or nsga2, moead (bound_s is then the point's own T)
   std::size_t runs = 0;          // runs per fresh sample
   std::vector<std::uint64_t> seeds;
   std::vector<FrontPoint> points;  // per choice, in order of the bounds
