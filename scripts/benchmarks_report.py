@@ -230,21 +230,29 @@ def main():
     ap.add_argument("--intro", help="a Markdown file put before the tables")
     a = ap.parse_args()
     parts = ["# Benchmarks: every method on the ADOPT suite\n",
-             "Written by `python3 scripts/benchmarks_report.py " + " ".join(sys.argv[1:]) + "` from the output of "
-             "`abuopt compare` (configs/compare/adopt_benchmarks.yaml, adopt_suite.yaml); do not edit by hand. "
-             "Per problem: the best-known value and its design, then per method over its runs (starts x seeds): "
-             "runs feasible in sample / out of sample, the median and range of the best in-sample objective and "
-             "of the validated (out-of-sample) objective over the runs feasible out of sample, that median's gap to the best validated value, and the evaluations until the best feasible in-sample "
-             "value is within 1 % / 2 % of f* (median over all runs, a run that never got there counting as infinite; in brackets how many got there).\n",
-             "Reproduce (measured: 37 min for the suite with Optuna's runs beside it and 3.5 min for the benchmarks, on 2 cores shared with other jobs; Optuna's runs "
-             "first, compare reads them as solvers with `external:`):\n\n"
+             "Which method to pick, from these tables: docs/optimizers.md, \"Which method for which problem\". "
+             "This page is written by `python3 scripts/benchmarks_report.py " + " ".join(sys.argv[1:]) + "` from "
+             "the output of `abuopt compare`; do not edit it by hand.\n",
+             "**How to read a table.** One row per method, over its runs (starts x seeds). *Feasible in / out of "
+             "sample*: runs whose returned design meets the constraints on the optimiser's own Monte Carlo runs / on "
+             "the validation runs (fresh initial conditions and parameter draws, another seed). *Median f (out)* and "
+             "its spread: the validated objective over the runs feasible out of sample; *median f (out, all runs)*: "
+             "the same median with an infeasible design counted as the worst, the figure to compare methods by; "
+             "*median gap*: that first median against the best validated design. *Evals to 1 % / 2 %*: the median "
+             "over every run (a run that never got there counts as infinite; in brackets how many got there) of the "
+             "evaluations until the run's best is within 1 % / 2 % of the best value; on the startup problems the "
+             "run's incumbent is validated along the way (`validation_checkpoints`) and the columns are measured out "
+             "of sample (in sample, the best value is a fit to the optimiser's own 32 or 128 runs that no design "
+             "keeps out of sample). Two-objective problems: hypervolume of each run's front against one reference "
+             "point, in sample and with every front point validated.\n",
+             "**Reproduce** (measured on 2 shared cores: Optuna's runs 44 min alongside the suite's compare 40 min, "
+             "then compare again with Optuna's runs and the fronts, 3 min; the smooth benchmarks 3 min):\n\n"
              "    for s in tpe cmaes; do for p in two_ball_19s two_ball_envelope ball_count_19s; do\n"
              "      python3 examples/python/optuna_study.py configs/compare/adopt_suite.yaml --problem $p "
              "--sampler $s --out results/optuna-$s; done; done\n"
              "    abuopt compare configs/compare/adopt_suite.yaml --out results/adopt_suite\n"
              "    abuopt compare configs/compare/adopt_benchmarks.yaml --out results/adopt_benchmarks\n"
-             "    python3 scripts/benchmarks_report.py results/adopt_suite results/adopt_benchmarks --out docs/benchmarks.md\n\n"
-             "Which method to pick, from these tables: docs/optimizers.md, \"Which method for which problem\".\n"]
+             "    python3 scripts/benchmarks_report.py results/adopt_suite results/adopt_benchmarks --out docs/benchmarks.md\n"]
     if a.intro:
         with open(a.intro) as f:
             parts.append(f.read().rstrip() + "\n")
