@@ -9,7 +9,8 @@
 namespace abuopt::plot_style {
 
 std::string colour(int k) {
-  static const std::array<const char*, 8> c = {kBlue, kOrange, kGreen, kRed, "#9467bd", "#8c564b", "#e377c2", kGrey};
+  static const std::array<const char*, 10> c = {kBlue,     kOrange,   kGreen,    kRed,      "#9467bd",
+                                                 "#8c564b", "#e377c2", kGrey,     "#bcbd22", "#17becf"};
   const int n = static_cast<int>(c.size());
   return c[static_cast<std::size_t>(((k % n) + n) % n)];
 }
@@ -35,9 +36,10 @@ std::string pdf_terminal_line(int width_px, int height_px) {
 std::string preamble() {
   std::ostringstream s;
   s << "set encoding utf8\n";
-  for (int k = 0; k < 8; ++k)
-    s << "set linetype " << k + 1 << " lc rgb '" << colour(k) << "' lw 2 pt " << (k == 0 ? 7 : k == 1 ? 5 : k == 2 ? 9 : k == 3 ? 13 : 7 + k)
-      << " ps 0.8\n";
+  // ten colours, then the same ten dashed: a comparison of 11 - 20 methods still tells them apart
+  for (int k = 0; k < 20; ++k)
+    s << "set linetype " << k + 1 << " lc rgb '" << colour(k) << "' lw 2 dt " << (k < 10 ? 1 : 2) << " pt "
+      << (k % 10 == 0 ? 7 : k % 10 == 1 ? 5 : k % 10 == 2 ? 9 : k % 10 == 3 ? 13 : 7 + k % 10) << " ps 0.8\n";
   s << "set border lw 1 lc rgb '#404040'\n"
     << "set tics out nomirror\n"
     << "set grid lc rgb '#d9d9d9' lw 1 dt solid\n"

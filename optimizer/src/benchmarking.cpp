@@ -648,7 +648,7 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
     const std::size_t ns = r.solvers.size();
     const Gnuplot probe;
     const std::string png_terminal = make_plots && probe.available() ? probe.terminal() : std::string("pngcairo");
-    const int w = 900, h = 600;
+    const int w = ns > 6 ? 1200 : 900, h = 600;  // many methods: the key goes beside the plot (below)
     auto begin_figure = [&](const std::string& png) {
       f << plot_style::png_terminal_line(png_terminal, w, h) << "set output " << Gnuplot::quote(png) << "\n";
     };
@@ -658,7 +658,10 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
     };
     f << "# gnuplot script written by abuopt compare; run in this folder: gnuplot plots.gp (PNG and PDF of each figure)\n";
     begin_figure("data_profile.png");
-    f << plot_style::preamble() << "set datafile separator ','\nset key bottom right\nset grid\nset yrange [0:1.05]\n";
+    // with many methods the key would cover the curves: it goes beside the plot
+    const std::string key_inside_at = ns > 6 ? "outside right top" : "";
+    f << plot_style::preamble() << "set datafile separator ','\nset key "
+      << (key_inside_at.empty() ? "bottom right" : key_inside_at) << "\nset grid\nset yrange [0:1.05]\n";
     f << "set title 'Data profile (τ = " << format_number(r.tau)
       << "): fraction of problems solved within α (n_p + 1) evaluations'\n"
       << "set xlabel 'α = evaluations / (n_p + 1)'\nset ylabel 'd_s(α)'\nplot ";
@@ -676,7 +679,8 @@ WrittenFiles write_comparison(const ComparisonResult& r, const std::string& dire
         << plot_style::literal(r.solvers[s]);
     f << "\n";
     end_figure("performance_profile.png");
-    f << "unset logscale x\nset datafile separator whitespace\nset autoscale y\nset logscale y\nset key top right\n"
+    f << "unset logscale x\nset datafile separator whitespace\nset autoscale y\nset logscale y\nset key "
+      << (key_inside_at.empty() ? "top right" : key_inside_at) << "\n"
       << "set format y '10^{%L}'\n";
     for (std::size_t p = 0; p < r.problems.size(); ++p) {
       begin_figure(pngs[2 + p]);

@@ -53,7 +53,8 @@ inline constexpr const char* kPctMi = "%MI [%]";
 // line width). `png_terminal`: "pngcairo" or, on a gnuplot without cairo, "png".
 std::string png_terminal_line(const std::string& png_terminal, int width_px, int height_px);
 std::string pdf_terminal_line(int width_px, int height_px);
-// The settings every figure starts with: encoding, line styles 1..8 in colour(k), grid, key, tics.
+// The settings every figure starts with: encoding, line types 1..10 in colour(k) and 11..20 the same
+// dashed, grid, key, tics.
 std::string preamble();
 // The whole script text of one figure: PNG then PDF of `body`, outputs `stem`.png and `stem`.pdf
 // (relative to the script's folder). `png_terminal` as above.
