@@ -1,5 +1,6 @@
 #include "abuopt/common/text.hpp"
 
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -55,6 +56,13 @@ std::string markdown_cell(const std::string& s) {
     else o += c;
   }
   return o;
+}
+
+std::string file_safe(const std::string& s) {
+  std::string out = s;
+  for (char& c : out)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+  return out;
 }
 
 }  // namespace abuopt

@@ -44,12 +44,7 @@ double solved_threshold(double f_star, double tau) { return tau * std::max(std::
 using abuopt::csv_number;
 std::string csv_text(const std::string& s) { return abuopt::csv_field(s); }
 
-std::string file_safe(const std::string& s) {
-  std::string out = s;
-  for (char& c : out)
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
-  return out;
-}
+using abuopt::file_safe;
 
 }  // namespace
 

@@ -24,13 +24,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string file_safe(const std::string& s) {
-  std::string out = s;
-  for (char& c : out)
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
-  return out;
-}
-
 FrontMethod read_method(YamlReader& r, const FrontProblem& fp, std::size_t dimension) {
   FrontMethod m;
   const std::string algorithm = r.get_string("algorithm");

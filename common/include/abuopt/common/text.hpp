@@ -32,4 +32,7 @@ std::string csv_optional(const std::optional<double>& v, int significant_digits)
 // '|' escaped, CR/LF as spaces: a Markdown table cell stays one cell.
 std::string markdown_cell(const std::string& s);
 
+// A label as a piece of a file name: every character but letters, digits, '-' and '_' becomes '_'.
+std::string file_safe(const std::string& s);
+
 }  // namespace abuopt
