@@ -246,7 +246,7 @@ def main():
              "keeps out of sample). Two-objective problems: hypervolume of each run's front against one reference "
              "point, in sample and with every front point validated.\n",
              "**Reproduce** (measured on 2 shared cores: Optuna's runs 44 min alongside the suite's compare 40 min, "
-             "then compare again with Optuna's runs and the fronts, 3 min; the smooth benchmarks 3 min):\n\n"
+             "then compare again with Optuna's runs and the fronts, 3 - 5 min; the smooth benchmarks 3 min):\n\n"
              "    for s in tpe cmaes; do for p in two_ball_19s two_ball_envelope ball_count_19s; do\n"
              "      python3 examples/python/optuna_study.py configs/compare/adopt_suite.yaml --problem $p "
              "--sampler $s --out results/optuna-$s; done; done\n"
