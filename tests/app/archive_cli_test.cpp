@@ -40,8 +40,11 @@ TEST(ArchiveCli, ListBestHistoryShowExport) {
   const auto opt = run_abuopt("optimize " + cfg + " --max-evaluations 5 --threads 2 --out " + (out / "opt").string());
   ASSERT_EQ(opt.status, 0) << opt.output;
   EXPECT_FALSE(fs::exists(out / "opt" / ".abuopt.lock"));
-  for (const auto& e : fs::directory_iterator(out / "opt"))
-    if (e.path().extension() == ".log") EXPECT_GT(fs::file_size(e.path()), 0u) << e.path();
+  for (const auto& e : fs::directory_iterator(out / "opt")) {
+    if (e.path().extension() == ".log") {
+      EXPECT_GT(fs::file_size(e.path()), 0u) << e.path();
+    }
+  }
   const std::string arc = (out / "opt" / "archive.sqlite").string();
 
   const auto list = run_abuopt("archive list " + arc);
