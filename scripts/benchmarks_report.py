@@ -245,8 +245,10 @@ def main():
              "of sample (in sample, the best value is a fit to the optimiser's own 32 or 128 runs that no design "
              "keeps out of sample). Two-objective problems: hypervolume of each run's front against one reference "
              "point, in sample and with every front point validated.\n",
-             "**Reproduce** (measured on 2 shared cores: Optuna's runs 44 min alongside the suite's compare 40 min, "
-             "then compare again with Optuna's runs and the fronts, 3 - 5 min; the smooth benchmarks 3 min):\n\n"
+             "**Reproduce** (measured on 2 shared cores: Optuna's runs 44 min; compare's own methods 40 min beside "
+             "them, with the suite's two `external:` solvers left out of a copy of the file and the same `--out`, so "
+             "that the archive answers those runs when the whole file runs after Optuna's; then Optuna's validations "
+             "and the fronts 3 - 5 min; in sequence, as below, about 90 min; the smooth benchmarks 3 min):\n\n"
              "    for s in tpe cmaes; do for p in two_ball_19s two_ball_envelope ball_count_19s; do\n"
              "      python3 examples/python/optuna_study.py configs/compare/adopt_suite.yaml --problem $p "
              "--sampler $s --out results/optuna-$s; done; done\n"

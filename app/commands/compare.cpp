@@ -37,6 +37,7 @@
 // the validations in OUT/archive/<problem>/validation.sqlite); the same command with the same --out
 // after a Ctrl-C or a kill answers them bit for bit, so finished runs cost no simulation and the
 // interrupted ones go on where they stopped. One progress line per run on stderr, with an ETA.
+#include <algorithm>
 #include <chrono>
 #include <ctime>
 #include <filesystem>
@@ -106,8 +107,8 @@ opt::ProblemSpec read_startup_profile_problem(YamlReader& r) {
     };
   }
   read_run_settings(r, spec);
-  spec.validation_checkpoints =
-      static_cast<int>(r.get_int_or("validation_checkpoints", 0, Rule::in_range(0, 1000)));
+  spec.validation_checkpoints = static_cast<int>(
+      r.get_int_or("validation_checkpoints", 0, Rule::in_range(0, std::min<long>(1000, spec.max_evaluations))));
   if (spec.validation_checkpoints > 0 && !spec.validate)
     throw ConfigError(r.key_path("validation_checkpoints"), std::to_string(spec.validation_checkpoints),
                       "needs the problem's validation (startup_profile.validation.enabled: true)");

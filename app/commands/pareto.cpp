@@ -146,12 +146,12 @@ int run_pareto_command(const ParetoArgs& a) {
   const ParetoSettings ps = read_pareto_settings(root.child("pareto"));
   YamlReader optimizer = root.child("optimizer");
   if (ps.method != ParetoSettings::Method::EpsilonConstraint)
-    for (const char* key : {"algorithm", "max_evaluations"})  // the method and its budget are pareto's
+    for (const char* key : {"algorithm", "max_evaluations", "population"})  // the method, budget, population: pareto's
       if (optimizer.has(key))
         throw ConfigError(optimizer.key_path(key), yaml_value_text(optimizer.node()[key]),
                           "must be absent with pareto.method " + to_string(ps.method) + ": the method is pareto.method, " +
-                              "its budget pareto.max_evaluations (optimizer gives seed, constraint_tolerance, " +
-                              "evaluation_threads, max_time_s)");
+                              "its budget pareto.max_evaluations, its population pareto.population (optimizer gives " +
+                              "seed, constraint_tolerance, evaluation_threads, max_time_s)");
   YamlReader sao = root.child("sao");
   opt::OptimizerOptions options = opt::read_optimizer_options(optimizer, &sao);
   finish_config(root);  // the file may also configure `abuopt optimize` and `abuopt sweep`

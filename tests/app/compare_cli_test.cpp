@@ -124,6 +124,18 @@ TEST(CompareCli, BadConfigIsOneMessageWithExitStatus2) {
     EXPECT_NE(r.err.find(c.message), std::string::npos) << "expected '" << c.message << "' in: " << r.err;
     EXPECT_EQ(r.err.find("terminate"), std::string::npos) << r.err;
   }
+  // more checkpoints than evaluations: the quick suite's two_ball_19s has 24
+  {
+    std::ifstream in(kConfigs + "compare/adopt_suite_quick.yaml");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string from = "validation_checkpoints: 4", to = "validation_checkpoints: 25";
+    ASSERT_NE(text.find(from), std::string::npos);
+    text.replace(text.find(from), from.size(), to);
+    const Result r = run("compare " + write_config("compare_bad_checkpoints.yaml", text) + " --out " +
+                         fresh_dir("compare_cli_bad"));
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_NE(r.err.find("problems[0].validation_checkpoints = 25: must be in [0, 24]"), std::string::npos) << r.err;
+  }
   const Result missing = run("compare " + kConfigs + "compare/no_such.yaml");
   EXPECT_EQ(missing.status, 2) << missing.err;
   EXPECT_NE(missing.err.find("no_such.yaml"), std::string::npos) << missing.err;

@@ -394,6 +394,16 @@ TEST(SweepCli, ParetoByNsga2AndMoeadWritesTheValidatedFrontAndResumes) {
   EXPECT_EQ(al.status, 2) << al.output;
   EXPECT_NE(al.output.find("optimizer.algorithm = cobyla: must be absent with pareto.method nsga2"), std::string::npos)
       << al.output;
+  // pagmo's population is pareto.population here, not optimizer.population (which would be ignored)
+  const std::string pop = write_config("pareto-opt-pop.yaml", std::string(kBase) +
+                                                                  "optimizer: {population: 12}\n"
+                                                                  "pareto: {method: nsga2, max_evaluations: 40, "
+                                                                  "reference: {objective: 25, second: 23}}\n");
+  const Result po = run("pareto " + pop + " --out " + fresh_dir("pareto-opt-pop").string());
+  EXPECT_EQ(po.status, 2) << po.output;
+  EXPECT_NE(po.output.find("optimizer.population = 12: must be absent with pareto.method nsga2"), std::string::npos)
+      << po.output;
+  EXPECT_NE(po.output.find("its population pareto.population"), std::string::npos) << po.output;
   const std::string eps = write_config("pareto-eps-pop.yaml", std::string(kBase) +
                                                                   "pareto: {max_startup_time_s: [12, 18], population: 20}\n");
   const Result ep = run("pareto " + eps + " --out " + fresh_dir("pareto-eps-pop").string());
