@@ -137,7 +137,11 @@ int run_population_front(const ParetoArgs& a, const problems::StartupProfileSett
               << "summary.json) and every evaluation in the archive; rerun the same command to resume\n";
     return stop_exit_status();
   }
-  return run.points.empty() ? 3 : 0;
+  if (run.reason.rfind("failure: ", 0) == 0)  // the run itself ended in an error: say which (exit 3)
+    std::cerr << "abuopt: the " << to_string(ps.method) << " run failed: " << run.reason.substr(9) << "\n";
+  else if (run.points.empty())
+    std::cerr << "abuopt: no feasible design in " << run.evaluations << " evaluations (" << run.reason << ")\n";
+  return run.points.empty() || run.reason.rfind("failure: ", 0) == 0 ? 3 : 0;
 }
 
 int run_pareto_command(const ParetoArgs& a) {
