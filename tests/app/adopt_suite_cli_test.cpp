@@ -3,7 +3,8 @@
 // variable), every run's design is
 // validated out of sample, the two-objective problem's fronts (NSGA-II, epsilon-constraint) are
 // written with their hypervolumes, and scripts/benchmarks_report.py turns the output into the
-// tables of docs/benchmarks.md with a row per method. About a minute on 2 cores: label long.
+// tables of docs/benchmarks.md with a row per method. 8 s on a quiet 2-core machine, about a minute loaded; in the default suite, so CI
+// runs the suite's quick form.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
